@@ -1,0 +1,67 @@
+#include "cli_common.h"
+
+#include <fmt/format.h>
+
+#include <cstdio>
+
+namespace vertexflow::cli {
+
+Mesh read_mesh_with_warnings(const std::filesystem::path& path, const GlobalOptions& global, ReadReport* report) {
+  ReadReport local;
+  ReadReport& r = report ? *report : local;
+  Mesh mesh = read_mesh(path, &r);
+  if (!global.quiet) {
+    for (const std::string& warning : r.warnings()) fmt::print(stderr, "vertexflow: warning: {}: {}\n", path.string(), warning);
+  }
+  return mesh;
+}
+
+std::string describe_format(const ReadReport& report) {
+  const char* names[] = {"OBJ", "PLY", "OFF", "STL"};
+  std::string s = names[static_cast<int>(report.format)];
+  if (report.format != MeshFormat::Obj) s += report.binary ? " (binary)" : " (ASCII)";
+  if (report.gzip) s += ", gzip";
+  return s;
+}
+
+nlohmann::json to_json(const QualityStats& stats) {
+  return {{"min", stats.min},
+          {"mean", stats.mean},
+          {"p5", stats.p5},
+          {"fraction_below_0_3", stats.fraction_below_0_3},
+          {"histogram", stats.histogram}};
+}
+
+nlohmann::json to_json(const MeshInfo& info) {
+  const auto vec = [](const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); };
+  return {{"vertices", info.num_vertices},
+          {"faces", info.num_faces},
+          {"edges", info.num_edges},
+          {"bounding_box", {{"min", vec(info.bounding_box.min)}, {"max", vec(info.bounding_box.max)}}},
+          {"diagonal", info.diagonal},
+          {"edge_length", {{"mean", info.edge_length_mean}, {"min", info.edge_length_min}, {"max", info.edge_length_max}}},
+          {"surface_area", info.surface_area},
+          {"components", info.components},
+          {"boundary_loops", info.boundary_loops},
+          {"euler_characteristic", info.euler_characteristic},
+          {"genus", info.genus >= 0 ? nlohmann::json(info.genus) : nlohmann::json(nullptr)},
+          {"manifold", info.manifold},
+          {"oriented", info.oriented},
+          {"closed", info.closed},
+          {"non_manifold_edges", info.non_manifold_edges},
+          {"non_manifold_vertices", info.non_manifold_vertices},
+          {"quality", to_json(info.quality)}};
+}
+
+nlohmann::json to_json(const ReadReport& report) {
+  return {{"format", describe_format(report)},
+          {"polygons_triangulated", report.polygons_triangulated},
+          {"polygons_fanned", report.polygons_fanned},
+          {"vertices_welded", report.vertices_welded},
+          {"unreferenced_vertices_removed", report.unreferenced_vertices_removed},
+          {"repeated_index_faces_removed", report.repeated_index_faces_removed},
+          {"duplicate_faces_removed", report.duplicate_faces_removed},
+          {"zero_area_faces_removed", report.zero_area_faces_removed}};
+}
+
+}  // namespace vertexflow::cli

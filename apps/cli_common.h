@@ -1,0 +1,34 @@
+// Pieces every `vertexflow` subcommand shares: reading with warnings, JSON conversion.
+#pragma once
+
+#include "vertexflow/io.h"
+#include "vertexflow/mesh_info.h"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <string>
+
+namespace vertexflow::cli {
+
+/// Options every subcommand has.
+struct GlobalOptions {
+  bool quiet = false;
+};
+
+/// Reads a mesh and prints one warning line per cleanup count to stderr (unless quiet).
+Mesh read_mesh_with_warnings(const std::filesystem::path& path, const GlobalOptions& global,
+                             ReadReport* report = nullptr);
+
+/// Human-readable format name, e.g. "PLY (binary)".
+std::string describe_format(const ReadReport& report);
+
+nlohmann::json to_json(const MeshInfo& info);
+nlohmann::json to_json(const QualityStats& stats);
+nlohmann::json to_json(const ReadReport& report);
+
+/// Registers the subcommands (one function per command file).
+void register_info_command(CLI::App& app, const GlobalOptions& global);
+
+}  // namespace vertexflow::cli

@@ -1,0 +1,28 @@
+// vertexflow: command-line interface. Each subcommand lives in its own command_*.cpp; this file
+// parses the command line and turns every error into one line on stderr and exit code 1.
+#include "cli_common.h"
+
+#include <fmt/format.h>
+
+#include <cstdio>
+#include <exception>
+
+int main(int argc, char** argv) {
+  using namespace vertexflow::cli;
+  CLI::App app{"vertexflow: enhance the shape features of triangle meshes by vertex flow"};
+  app.require_subcommand(1);
+  app.set_version_flag("--version", "vertexflow 0.1.0");
+  GlobalOptions global;
+  app.add_flag("-q,--quiet", global.quiet, "Print no warnings or progress")->configurable(false);
+  app.fallthrough();
+  register_info_command(app, global);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e);
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "vertexflow: error: {}\n", e.what());
+    return 1;
+  }
+  return 0;
+}

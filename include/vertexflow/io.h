@@ -1,0 +1,109 @@
+// Mesh input and output: OBJ, PLY (ASCII, binary little/big endian), OFF (ASCII, binary), STL
+// (ASCII, binary), each optionally gzip-compressed on input and output (`NAME.EXT.gz`).
+//
+// Reading produces a clean triangle mesh:
+// - polygons are triangulated (quads by the valid, better-shaped diagonal; larger polygons by a
+//   constrained Delaunay triangulation in their best-fit plane, so non-convex ones are right);
+// - STL's per-facet vertices are welded (bitwise-equal positions become one vertex);
+// - unreferenced vertices, faces with a repeated index, duplicate faces (same vertex set, any
+//   order or orientation) and zero-area faces (area < kDegenerateAreaRelative * diagonal^2) are
+//   removed, each counted in ReadReport;
+// - otherwise vertex order is kept, so per-vertex data in the file stays aligned.
+//
+// Every failure throws IoError with a one-line message that starts with the file name.
+// Allocation is bounded by the file's size: a header that claims more elements than the file
+// can hold is an error, not an allocation.
+#pragma once
+
+#include "vertexflow/mesh.h"
+
+#include <cstdint>
+#include <filesystem>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace vertexflow {
+
+/// Thrown by every reader and writer. what() is "FILE: problem" on one line.
+class IoError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+enum class MeshFormat { Obj, Ply, Off, Stl };
+
+/// File format from the extension (case-insensitive, a trailing ".gz" ignored).
+/// Throws IoError for an unknown extension.
+MeshFormat format_from_path(const std::filesystem::path& path);
+
+/// Whether the path ends in ".gz" (case-insensitive).
+bool is_gzip_path(const std::filesystem::path& path);
+
+struct ReadOptions {
+  /// Upper bound on the decompressed size of a gzip file; a larger stream is an error.
+  std::uint64_t max_decompressed_bytes = std::uint64_t{16} << 30;
+  /// Remove faces whose area is below kDegenerateAreaRelative * diagonal^2.
+  bool remove_zero_area_faces = true;
+};
+
+/// What reading had to change to produce a clean triangle mesh. Every count is also a warning.
+struct ReadReport {
+  MeshFormat format = MeshFormat::Obj;
+  bool binary = false;
+  bool gzip = false;
+  /// Polygons with more than three vertices that were triangulated.
+  std::int64_t polygons_triangulated = 0;
+  /// Polygons that could not be triangulated in their plane (self-intersecting or folded) and
+  /// were fanned from their first vertex instead.
+  std::int64_t polygons_fanned = 0;
+  /// Vertices merged into an earlier identical one (STL only).
+  std::int64_t vertices_welded = 0;
+  std::int64_t unreferenced_vertices_removed = 0;
+  /// Faces with fewer than three distinct vertex indices.
+  std::int64_t repeated_index_faces_removed = 0;
+  std::int64_t duplicate_faces_removed = 0;
+  std::int64_t zero_area_faces_removed = 0;
+
+  /// One human-readable line per non-zero count, e.g. "removed 3 duplicate faces".
+  [[nodiscard]] std::vector<std::string> warnings() const;
+};
+
+/// Reads a mesh, choosing the format from the extension. Throws IoError.
+Mesh read_mesh(const std::filesystem::path& path, ReadReport* report = nullptr,
+               const ReadOptions& options = {});
+
+/// Reads a mesh from bytes already in memory (used by the fuzzers and by read_mesh).
+/// `name` is used in error messages only. gzip data is recognised by its magic bytes.
+Mesh read_mesh_from_memory(std::string_view bytes, MeshFormat format, const std::string& name,
+                           ReadReport* report = nullptr, const ReadOptions& options = {});
+
+enum class PlyEncoding { BinaryLittleEndian, BinaryBigEndian, Ascii };
+
+struct WriteOptions {
+  /// PLY encoding; binary little-endian by default (compact, fast, read by every tool).
+  PlyEncoding ply_encoding = PlyEncoding::BinaryLittleEndian;
+  /// PLY vertex coordinates as float64 (exact round trip) or float32 (half the size).
+  bool ply_double_precision = true;
+  /// STL: binary by default (float32 coordinates, as the format defines), ASCII when false.
+  bool stl_binary = true;
+  /// OFF: ASCII by default; binary OFF (big-endian float32) when true.
+  bool off_binary = false;
+  /// Write per-vertex colours where the format can carry them (PLY, OFF as COFF).
+  bool write_colors = true;
+  /// Write per-vertex scalar properties (PLY only; other formats ignore them).
+  bool write_vertex_properties = true;
+};
+
+/// Writes a mesh, format chosen by extension (".gz" compresses). The file is written to a
+/// temporary file in the same directory and renamed into place, so `path` is either left as it
+/// was or holds the complete new mesh. Throws IoError.
+void write_mesh(const std::filesystem::path& path, const Mesh& mesh,
+                const WriteOptions& options = {});
+
+/// Throws IoError unless `output` is safe to write while `input` is being processed: it must
+/// not be the same file as the input (unless `force`), and must not be a directory.
+void check_output_path(const std::filesystem::path& input, const std::filesystem::path& output,
+                       bool force);
+
+}  // namespace vertexflow

@@ -1,0 +1,83 @@
+// vertexflow: feature enhancement of triangle meshes by vertex flow.
+//
+// The mesh type every stage of the library works on, and the conventions the whole library
+// shares. They are stated once, here.
+//
+// Conventions
+// - Positions are double precision, one row per vertex (x, y, z), in the input's own units;
+//   nothing in the library rescales a mesh the caller gives it unless a function says so.
+// - Triangles are rows of three 0-based vertex indices. The orientation (i, j, k) defines the
+//   face normal (v_j - v_i) x (v_k - v_i): counter-clockwise seen from the side the normal
+//   points to. For a closed mesh with consistent orientation the normals point outwards when
+//   the signed volume is positive.
+// - Both matrices are row-major so a vertex or face is contiguous in memory; they interoperate
+//   with libigl-style V/F (Eigen::MatrixXd / Eigen::MatrixXi) by plain assignment.
+// - Per-vertex data (properties, colours) is aligned with the rows of V.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace vertexflow {
+
+/// Vertex and face index type. 32 bits, as in libigl; meshes are limited to 2^31 - 1 elements.
+using Index = std::int32_t;
+
+/// Vertex positions: #V x 3, row-major.
+using Vertices = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+/// Triangles: #F x 3 vertex indices, row-major.
+using Faces = Eigen::Matrix<Index, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+/// 8-bit RGB colours, one row per vertex.
+using Colors = Eigen::Matrix<std::uint8_t, Eigen::Dynamic, 3, Eigen::RowMajor>;
+
+/// A named scalar per vertex (e.g. "k1", "quality"); values.size() equals the vertex count.
+struct VertexProperty {
+  std::string name;
+  Eigen::VectorXd values;
+};
+
+/// Relative area below which a triangle counts as degenerate: area < kDegenerateAreaRelative *
+/// (bounding-box diagonal)^2. The same bound is used when reading (such faces are removed) and
+/// when measuring a result (../docs/metrics: "degenerate faces").
+inline constexpr double kDegenerateAreaRelative = 1e-12;
+
+/// A triangle mesh with optional per-vertex data.
+struct Mesh {
+  Vertices V;
+  Faces F;
+  /// Optional per-vertex colours; empty (0 rows) or #V rows.
+  Colors colors;
+  /// Optional per-vertex scalar properties, written to PLY as `property double NAME`.
+  std::vector<VertexProperty> vertex_properties;
+
+  [[nodiscard]] Index num_vertices() const { return static_cast<Index>(V.rows()); }
+  [[nodiscard]] Index num_faces() const { return static_cast<Index>(F.rows()); }
+
+  /// Adds or replaces the property called `name`. `values.size()` must equal num_vertices().
+  void set_vertex_property(std::string name, Eigen::VectorXd values);
+  /// The property called `name`, or nullptr.
+  [[nodiscard]] const VertexProperty* find_vertex_property(std::string_view name) const;
+};
+
+/// Axis-aligned bounding box of the vertices. For an empty mesh min = max = 0.
+struct BoundingBox {
+  Eigen::Vector3d min = Eigen::Vector3d::Zero();
+  Eigen::Vector3d max = Eigen::Vector3d::Zero();
+  [[nodiscard]] double diagonal() const { return (max - min).norm(); }
+};
+
+/// Bounding box of V's rows.
+BoundingBox bounding_box(const Vertices& V);
+
+/// Area of triangle f.
+double face_area(const Vertices& V, const Faces& F, Index f);
+
+}  // namespace vertexflow

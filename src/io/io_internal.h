@@ -1,0 +1,216 @@
+// Internal pieces shared by the readers and writers. Not installed.
+#pragma once
+
+#include "vertexflow/io.h"
+
+#include <charconv>
+#include <cstdint>
+#include <cstring>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <unordered_set>
+#include <vector>
+
+namespace vertexflow::io_detail {
+
+/// What a parser produces: vertices and polygons exactly as the file lists them.
+struct PolygonSoup {
+  std::vector<double> xyz;                    // 3 per vertex
+  std::vector<Index> corners;                 // polygon corners, concatenated
+  std::vector<std::int64_t> offsets{0};       // polygon p is corners[offsets[p], offsets[p+1])
+  std::vector<std::uint8_t> rgb;              // empty or 3 per vertex
+  std::vector<VertexProperty> properties;     // per-vertex scalars other than x, y, z, colours
+  bool weld_vertices = false;                 // STL: facets carry their own vertex copies
+
+  [[nodiscard]] std::int64_t num_vertices() const {
+    return static_cast<std::int64_t>(xyz.size() / 3);
+  }
+  [[nodiscard]] std::int64_t num_polygons() const {
+    return static_cast<std::int64_t>(offsets.size()) - 1;
+  }
+  void add_vertex(double x, double y, double z) {
+    xyz.push_back(x);
+    xyz.push_back(y);
+    xyz.push_back(z);
+  }
+  void end_polygon() { offsets.push_back(static_cast<std::int64_t>(corners.size())); }
+};
+
+/// Throws IoError("name: message").
+[[noreturn]] void fail(const std::string& name, const std::string& message);
+
+// Parsers: bytes (already decompressed) -> soup. Each throws IoError naming `name`.
+PolygonSoup parse_obj(std::string_view bytes, const std::string& name);
+PolygonSoup parse_ply(std::string_view bytes, const std::string& name, ReadReport& report);
+PolygonSoup parse_off(std::string_view bytes, const std::string& name, ReadReport& report);
+PolygonSoup parse_stl(std::string_view bytes, const std::string& name, ReadReport& report);
+
+/// Validates the soup and turns it into a clean triangle mesh (see io.h for what is removed).
+Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& report,
+                  const ReadOptions& options);
+
+/// Undirected edges of a polygon mesh, to keep quad diagonals from duplicating an edge.
+using EdgeSet = std::unordered_set<std::uint64_t>;
+inline std::uint64_t edge_key(Index a, Index b) {
+  if (a > b) std::swap(a, b);
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
+}
+
+/// Triangulates one polygon (corner indices into xyz) and appends triangles to `out`
+/// (3 indices each). `edges` holds the mesh's edges so far: a quad prefers a diagonal that is
+/// not already an edge (otherwise two folded quads can produce the same triangle twice), and
+/// the chosen diagonal is added. Returns false if it had to fall back to a fan because the
+/// polygon has no valid triangulation in its best-fit plane (self-intersecting, folded or
+/// degenerate).
+bool triangulate_polygon(const double* xyz, const Index* corners, std::size_t count, EdgeSet& edges,
+                         std::vector<Index>& out);
+
+/// Inflates gzip data; throws if the result would exceed max_bytes.
+std::string gunzip(std::string_view compressed, const std::string& name, std::uint64_t max_bytes);
+
+/// True for data starting with the gzip magic bytes.
+inline bool has_gzip_magic(std::string_view bytes) {
+  return bytes.size() >= 2 && static_cast<unsigned char>(bytes[0]) == 0x1f &&
+         static_cast<unsigned char>(bytes[1]) == 0x8b;
+}
+
+/// Byte order helpers for binary formats.
+inline bool host_is_little_endian() {
+  const std::uint16_t one = 1;
+  unsigned char first = 0;
+  std::memcpy(&first, &one, 1);
+  return first == 1;
+}
+
+template <class T>
+T load_scalar(const char* p, bool swap) {
+  unsigned char bytes[sizeof(T)];
+  std::memcpy(bytes, p, sizeof(T));
+  if (swap) {
+    for (std::size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(bytes[i], bytes[sizeof(T) - 1 - i]);
+  }
+  T value;
+  std::memcpy(&value, bytes, sizeof(T));
+  return value;
+}
+
+template <class T>
+void store_scalar(std::string& out, T value, bool swap) {
+  unsigned char bytes[sizeof(T)];
+  std::memcpy(bytes, &value, sizeof(T));
+  if (swap) {
+    for (std::size_t i = 0; i < sizeof(T) / 2; ++i) std::swap(bytes[i], bytes[sizeof(T) - 1 - i]);
+  }
+  out.append(reinterpret_cast<const char*>(bytes), sizeof(T));
+}
+
+/// Appends the shortest decimal text that reads back as exactly `value`.
+inline void append_double(std::string& out, double value) {
+  char buffer[32];
+  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+  out.append(buffer, result.ptr);
+}
+
+inline void append_int(std::string& out, std::int64_t value) {
+  char buffer[24];
+  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+  out.append(buffer, result.ptr);
+}
+
+/// A cursor over ASCII text that reports errors with the line number.
+/// Line numbers are counted only when an error is reported, so scanning stays fast.
+class TextScanner {
+ public:
+  TextScanner(std::string_view text, const std::string& name) : text_(text), name_(name) {}
+
+  [[nodiscard]] std::size_t position() const { return pos_; }
+  [[nodiscard]] bool at_end() const { return pos_ >= text_.size(); }
+  [[nodiscard]] char peek() const { return pos_ < text_.size() ? text_[pos_] : '\0'; }
+  [[nodiscard]] std::size_t remaining() const { return text_.size() - pos_; }
+  [[nodiscard]] std::string_view rest() const { return text_.substr(pos_); }
+  void advance(std::size_t n) { pos_ += n; }
+
+  /// Skips spaces and tabs (and a '\r'), not newlines.
+  void skip_blanks() {
+    while (pos_ < text_.size() &&
+           (text_[pos_] == ' ' || text_[pos_] == '\t' || text_[pos_] == '\r'))
+      ++pos_;
+  }
+  /// Skips all whitespace including newlines; with `comments`, also '#' to end of line.
+  void skip_whitespace(bool comments = false) {
+    while (pos_ < text_.size()) {
+      const char c = text_[pos_];
+      if (c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v') {
+        ++pos_;
+      } else if (comments && c == '#') {
+        skip_line();
+      } else {
+        break;
+      }
+    }
+  }
+  /// Moves past the next '\n' (or to the end).
+  void skip_line() {
+    const std::size_t nl = text_.find('\n', pos_);
+    pos_ = nl == std::string_view::npos ? text_.size() : nl + 1;
+  }
+  [[nodiscard]] bool at_line_end() const {
+    return pos_ >= text_.size() || text_[pos_] == '\n' || text_[pos_] == '#';
+  }
+  /// The next whitespace-delimited token on the current line (empty at the line's end).
+  std::string_view token_on_line() {
+    skip_blanks();
+    const std::size_t start = pos_;
+    while (pos_ < text_.size() && !is_space(text_[pos_])) ++pos_;
+    return text_.substr(start, pos_ - start);
+  }
+  /// The next token, crossing lines (and comments when `comments`).
+  std::string_view token(bool comments = false) {
+    skip_whitespace(comments);
+    const std::size_t start = pos_;
+    while (pos_ < text_.size() && !is_space(text_[pos_])) ++pos_;
+    return text_.substr(start, pos_ - start);
+  }
+
+  /// Parses a number from a token; fails with "expected WHAT".
+  double to_double(std::string_view tok, const char* what) const {
+    if (!tok.empty() && tok.front() == '+') tok.remove_prefix(1);
+    double value = 0;
+    const auto [ptr, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), value);
+    if (tok.empty() || ptr != tok.data() + tok.size() ||
+        (ec != std::errc() && ec != std::errc::result_out_of_range))
+      error(std::string("expected ") + what + ", found '" + printable(tok) + "'");
+    return value;
+  }
+  std::int64_t to_int(std::string_view tok, const char* what) const {
+    if (!tok.empty() && tok.front() == '+') tok.remove_prefix(1);
+    std::int64_t value = 0;
+    const auto [ptr, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), value);
+    if (tok.empty() || ptr != tok.data() + tok.size() || ec != std::errc())
+      error(std::string("expected ") + what + ", found '" + printable(tok) + "'");
+    return value;
+  }
+  double next_double(const char* what, bool comments = false) {
+    return to_double(token(comments), what);
+  }
+  std::int64_t next_int(const char* what, bool comments = false) {
+    return to_int(token(comments), what);
+  }
+
+  /// Throws IoError("name: line N: message").
+  [[noreturn]] void error(const std::string& message) const;
+
+  static bool is_space(char c) {
+    return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v';
+  }
+  /// At most 40 characters of a token, with control bytes replaced, for error messages.
+  static std::string printable(std::string_view tok);
+
+ private:
+  std::string_view text_;
+  const std::string& name_;
+  std::size_t pos_ = 0;
+};
+
+}  // namespace vertexflow::io_detail

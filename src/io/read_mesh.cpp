@@ -1,0 +1,398 @@
+// Reading: load the bytes (decompressing gzip), dispatch to a format parser, then turn the
+// polygon soup into a clean triangle mesh.
+#include "io_internal.h"
+
+#include <zlib.h>
+
+#include <algorithm>
+#include <array>
+#include <cerrno>
+#include <cmath>
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <sys/stat.h>
+#include <unistd.h>
+#include <unordered_map>
+
+namespace vertexflow {
+namespace io_detail {
+
+void fail(const std::string& name, const std::string& message) {
+  throw IoError(name + ": " + message);
+}
+
+void TextScanner::error(const std::string& message) const {
+  const std::size_t end = std::min(pos_, text_.size());
+  const auto line = 1 + std::count(text_.begin(), text_.begin() + static_cast<std::ptrdiff_t>(end), '\n');
+  fail(name_, fmt::format("line {}: {}", line, message));
+}
+
+std::string TextScanner::printable(std::string_view tok) {
+  std::string out;
+  for (const char c : tok.substr(0, 40)) {
+    out.push_back(static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) > 126 ? '?' : c);
+  }
+  if (tok.size() > 40) out += "...";
+  return out;
+}
+
+std::string gunzip(std::string_view compressed, const std::string& name, std::uint64_t max_bytes) {
+  z_stream stream{};
+  // 16 + MAX_WBITS: expect a gzip header; concatenated members are handled by the loop below.
+  if (inflateInit2(&stream, 16 + MAX_WBITS) != Z_OK) fail(name, "cannot initialise gzip decoder");
+  std::string out;
+  out.resize(std::min<std::uint64_t>(std::max<std::size_t>(compressed.size() * 4, 1 << 16), max_bytes));
+  stream.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(compressed.data()));
+  std::size_t consumed = 0;
+  std::size_t produced = 0;
+  for (;;) {
+    const std::size_t in_chunk = std::min<std::size_t>(compressed.size() - consumed, 1u << 30);
+    stream.avail_in = static_cast<uInt>(in_chunk);
+    if (produced == out.size()) {
+      if (out.size() >= max_bytes) {
+        inflateEnd(&stream);
+        fail(name, fmt::format("gzip data decompresses to more than {} bytes", max_bytes));
+      }
+      out.resize(std::min<std::uint64_t>(out.size() * 2, max_bytes));
+    }
+    const std::size_t out_chunk = std::min<std::size_t>(out.size() - produced, 1u << 30);
+    stream.next_out = reinterpret_cast<Bytef*>(out.data() + produced);
+    stream.avail_out = static_cast<uInt>(out_chunk);
+    const int rc = inflate(&stream, Z_NO_FLUSH);
+    consumed += in_chunk - stream.avail_in;
+    produced += out_chunk - stream.avail_out;
+    if (rc == Z_STREAM_END) {
+      if (consumed < compressed.size() && has_gzip_magic(compressed.substr(consumed))) {
+        inflateReset(&stream);  // another gzip member follows
+        continue;
+      }
+      break;
+    }
+    if (rc == Z_BUF_ERROR && consumed == compressed.size()) {
+      inflateEnd(&stream);
+      fail(name, "truncated gzip data");
+    }
+    if (rc != Z_OK && rc != Z_BUF_ERROR) {
+      const std::string why = stream.msg ? stream.msg : "corrupt data";
+      inflateEnd(&stream);
+      fail(name, "invalid gzip data (" + why + ")");
+    }
+  }
+  inflateEnd(&stream);
+  out.resize(produced);
+  return out;
+}
+
+namespace {
+
+std::string read_file_bytes(const std::filesystem::path& path) {
+  const std::string name = path.string();
+  const int fd = ::open(name.c_str(), O_RDONLY | O_CLOEXEC);
+  if (fd < 0) fail(name, std::string("cannot open: ") + std::strerror(errno));
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) {
+    const int err = errno;
+    ::close(fd);
+    fail(name, std::string("cannot stat: ") + std::strerror(err));
+  }
+  if (S_ISDIR(st.st_mode)) {
+    ::close(fd);
+    fail(name, "is a directory, not a mesh file");
+  }
+  if (!S_ISREG(st.st_mode)) {
+    ::close(fd);
+    fail(name, "is not a regular file");
+  }
+  std::string bytes;
+  bytes.resize(static_cast<std::size_t>(st.st_size));
+  std::size_t done = 0;
+  while (done < bytes.size()) {
+    const ssize_t n = ::read(fd, bytes.data() + done, bytes.size() - done);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      const int err = errno;
+      ::close(fd);
+      fail(name, std::string("read error: ") + std::strerror(err));
+    }
+    if (n == 0) break;  // the file shrank while we read it
+    done += static_cast<std::size_t>(n);
+  }
+  ::close(fd);
+  bytes.resize(done);
+  return bytes;
+}
+
+// Marks faces that repeat an earlier face's vertex set. Faces are bucketed by their smallest
+// vertex (a counting sort, linear time), so only faces sharing that vertex are compared.
+std::vector<char> find_duplicate_faces(const std::vector<Index>& tris, Index num_vertices) {
+  const std::size_t nf = tris.size() / 3;
+  std::vector<std::array<Index, 3>> keys(nf);
+  std::vector<Index> start(static_cast<std::size_t>(num_vertices) + 1, 0);
+  for (std::size_t f = 0; f < nf; ++f) {
+    std::array<Index, 3> k{tris[3 * f], tris[3 * f + 1], tris[3 * f + 2]};
+    std::sort(k.begin(), k.end());
+    keys[f] = k;
+    ++start[static_cast<std::size_t>(k[0]) + 1];
+  }
+  for (std::size_t v = 0; v < static_cast<std::size_t>(num_vertices); ++v) start[v + 1] += start[v];
+  std::vector<Index> order(nf);
+  {
+    std::vector<Index> fill(start.begin(), start.end() - 1);
+    for (std::size_t f = 0; f < nf; ++f) order[static_cast<std::size_t>(fill[keys[f][0]]++)] = static_cast<Index>(f);
+  }
+  std::vector<char> duplicate(nf, 0);
+  for (std::size_t v = 0; v < static_cast<std::size_t>(num_vertices); ++v) {
+    const auto begin = order.begin() + start[v];
+    const auto end = order.begin() + start[v + 1];
+    if (end - begin < 2) continue;
+    // Faces within a bucket are in increasing face order, so the first of equal keys is kept.
+    std::stable_sort(begin, end, [&](Index a, Index b) { return keys[a] < keys[b]; });
+    for (auto it = begin + 1; it != end; ++it) {
+      if (keys[*it] == keys[*(it - 1)]) duplicate[static_cast<std::size_t>(*it)] = 1;
+    }
+  }
+  return duplicate;
+}
+
+struct BitwisePositionHash {
+  std::size_t operator()(const std::array<std::uint64_t, 3>& p) const {
+    std::uint64_t h = 0x9e3779b97f4a7c15ull;
+    for (const auto x : p) h = (h ^ x) * 0xff51afd7ed558ccdull ^ (h >> 29);
+    return static_cast<std::size_t>(h);
+  }
+};
+
+// Merges vertices with identical coordinates (STL facets). Keeps first-occurrence order.
+void weld_identical_vertices(PolygonSoup& soup, ReadReport& report) {
+  const std::size_t nv = static_cast<std::size_t>(soup.num_vertices());
+  std::unordered_map<std::array<std::uint64_t, 3>, Index, BitwisePositionHash> index_of;
+  index_of.reserve(nv / 4 + 16);
+  std::vector<Index> remap(nv);
+  std::vector<double> welded;
+  welded.reserve(soup.xyz.size() / 4 + 16);
+  for (std::size_t v = 0; v < nv; ++v) {
+    std::array<std::uint64_t, 3> key{};
+    for (int c = 0; c < 3; ++c) {
+      const double x = soup.xyz[3 * v + static_cast<std::size_t>(c)] + 0.0;  // -0 becomes +0
+      std::memcpy(&key[static_cast<std::size_t>(c)], &x, sizeof(double));
+    }
+    const auto [it, inserted] = index_of.try_emplace(key, static_cast<Index>(welded.size() / 3));
+    if (inserted) welded.insert(welded.end(), soup.xyz.begin() + 3 * static_cast<std::ptrdiff_t>(v),
+                                soup.xyz.begin() + 3 * static_cast<std::ptrdiff_t>(v) + 3);
+    remap[v] = it->second;
+  }
+  for (auto& c : soup.corners) c = remap[static_cast<std::size_t>(c)];
+  report.vertices_welded += static_cast<std::int64_t>(nv - welded.size() / 3);
+  soup.xyz = std::move(welded);
+}
+
+}  // namespace
+
+Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& report,
+                  const ReadOptions& options) {
+  const std::int64_t nv64 = soup.num_vertices();
+  if (nv64 == 0) fail(name, "the file contains no vertices");
+  if (soup.num_polygons() == 0) fail(name, "the file contains no faces");
+  if (nv64 > std::numeric_limits<Index>::max())
+    fail(name, fmt::format("{} vertices exceed the supported maximum of 2^31-1", nv64));
+  for (std::size_t i = 0; i < soup.xyz.size(); ++i) {
+    if (!std::isfinite(soup.xyz[i]))
+      fail(name, fmt::format("vertex {} has a non-finite coordinate ({})", i / 3, soup.xyz[i]));
+  }
+  for (std::int64_t p = 0; p < soup.num_polygons(); ++p) {
+    const auto size = soup.offsets[static_cast<std::size_t>(p) + 1] - soup.offsets[static_cast<std::size_t>(p)];
+    if (size < 3) fail(name, fmt::format("face {} has {} vertices; a face needs at least 3", p, size));
+    for (auto c = soup.offsets[static_cast<std::size_t>(p)]; c < soup.offsets[static_cast<std::size_t>(p) + 1]; ++c) {
+      const Index v = soup.corners[static_cast<std::size_t>(c)];
+      if (v < 0 || v >= nv64)
+        fail(name, fmt::format("face {} references vertex {}, but the file has {} vertices (valid: 0..{})",
+                               p, v, nv64, nv64 - 1));
+    }
+  }
+  if (soup.weld_vertices) weld_identical_vertices(soup, report);
+  const Index nv = static_cast<Index>(soup.num_vertices());
+
+  // Triangulate, dropping faces with fewer than three distinct vertices.
+  std::vector<Index> tris;
+  tris.reserve(soup.corners.size());
+  std::vector<Index> polygon;
+  EdgeSet edges;  // filled only when the file has polygons
+  const bool has_polygons = soup.corners.size() != 3 * static_cast<std::size_t>(soup.num_polygons());
+  if (has_polygons) {
+    for (std::int64_t p = 0; p < soup.num_polygons(); ++p) {
+      const auto begin = soup.offsets[static_cast<std::size_t>(p)], end = soup.offsets[static_cast<std::size_t>(p) + 1];
+      for (auto c = begin; c < end; ++c)
+        edges.insert(edge_key(soup.corners[static_cast<std::size_t>(c)], soup.corners[static_cast<std::size_t>(c + 1 < end ? c + 1 : begin)]));
+    }
+  }
+  for (std::int64_t p = 0; p < soup.num_polygons(); ++p) {
+    const Index* c = soup.corners.data() + soup.offsets[static_cast<std::size_t>(p)];
+    const std::size_t n = static_cast<std::size_t>(soup.offsets[static_cast<std::size_t>(p) + 1] - soup.offsets[static_cast<std::size_t>(p)]);
+    if (n == 3) {
+      if (c[0] == c[1] || c[1] == c[2] || c[2] == c[0]) {
+        ++report.repeated_index_faces_removed;
+      } else {
+        tris.insert(tris.end(), c, c + 3);
+      }
+      continue;
+    }
+    // Polygon: drop consecutive repeats (including last == first) before triangulating.
+    polygon.clear();
+    for (std::size_t i = 0; i < n; ++i) {
+      if (polygon.empty() || polygon.back() != c[i]) polygon.push_back(c[i]);
+    }
+    while (polygon.size() > 1 && polygon.back() == polygon.front()) polygon.pop_back();
+    std::vector<Index> distinct = polygon;
+    std::sort(distinct.begin(), distinct.end());
+    if (std::unique(distinct.begin(), distinct.end()) - distinct.begin() < 3) {
+      ++report.repeated_index_faces_removed;
+      continue;
+    }
+    if (polygon.size() == 3) {
+      tris.insert(tris.end(), polygon.begin(), polygon.end());
+      continue;
+    }
+    ++report.polygons_triangulated;
+    if (!triangulate_polygon(soup.xyz.data(), polygon.data(), polygon.size(), edges, tris))
+      ++report.polygons_fanned;
+  }
+  // Fanning a polygon with a repeated corner can create triangles with a repeated index.
+  {
+    std::size_t out = 0;
+    for (std::size_t f = 0; f < tris.size() / 3; ++f) {
+      const Index a = tris[3 * f], b = tris[3 * f + 1], c = tris[3 * f + 2];
+      if (a == b || b == c || c == a) {
+        ++report.repeated_index_faces_removed;
+        continue;
+      }
+      tris[3 * out] = a, tris[3 * out + 1] = b, tris[3 * out + 2] = c;
+      ++out;
+    }
+    tris.resize(3 * out);
+  }
+
+  Mesh mesh;
+  mesh.V = Eigen::Map<const Vertices>(soup.xyz.data(), nv, 3);
+  const double diagonal = bounding_box(mesh.V).diagonal();
+  const double min_area = kDegenerateAreaRelative * diagonal * diagonal;
+
+  const std::vector<char> duplicate = find_duplicate_faces(tris, nv);
+  std::size_t kept = 0;
+  for (std::size_t f = 0; f < tris.size() / 3; ++f) {
+    if (duplicate[f]) {
+      ++report.duplicate_faces_removed;
+      continue;
+    }
+    if (options.remove_zero_area_faces) {
+      const Eigen::Vector3d a = mesh.V.row(tris[3 * f]);
+      const Eigen::Vector3d b = mesh.V.row(tris[3 * f + 1]);
+      const Eigen::Vector3d c = mesh.V.row(tris[3 * f + 2]);
+      if (0.5 * (b - a).cross(c - a).norm() < min_area) {
+        ++report.zero_area_faces_removed;
+        continue;
+      }
+    }
+    for (int k = 0; k < 3; ++k) tris[3 * kept + static_cast<std::size_t>(k)] = tris[3 * f + static_cast<std::size_t>(k)];
+    ++kept;
+  }
+  if (kept == 0) fail(name, "no valid faces remain (all faces are degenerate or repeated)");
+  mesh.F = Eigen::Map<const Faces>(tris.data(), static_cast<Eigen::Index>(kept), 3);
+
+  if (!soup.rgb.empty()) mesh.colors = Eigen::Map<const Colors>(soup.rgb.data(), nv, 3);
+  mesh.vertex_properties = std::move(soup.properties);
+
+  // Remove unreferenced vertices, keeping the order of the others.
+  std::vector<Index> new_index(static_cast<std::size_t>(nv), -1);
+  for (Eigen::Index i = 0; i < mesh.F.size(); ++i) new_index[static_cast<std::size_t>(mesh.F.data()[i])] = 0;
+  Index used = 0;
+  for (auto& v : new_index) {
+    if (v == 0) v = used++;
+  }
+  if (used < nv) {
+    report.unreferenced_vertices_removed += nv - used;
+    auto compact_rows = [&](auto& matrix) {
+      for (Index v = 0; v < nv; ++v) {
+        if (new_index[static_cast<std::size_t>(v)] >= 0) matrix.row(new_index[static_cast<std::size_t>(v)]) = matrix.row(v);
+      }
+      matrix.conservativeResize(used, Eigen::NoChange);
+    };
+    compact_rows(mesh.V);
+    if (mesh.colors.rows() > 0) compact_rows(mesh.colors);
+    for (auto& property : mesh.vertex_properties) {
+      for (Index v = 0; v < nv; ++v) {
+        if (new_index[static_cast<std::size_t>(v)] >= 0) property.values[new_index[static_cast<std::size_t>(v)]] = property.values[v];
+      }
+      property.values.conservativeResize(used);
+    }
+    for (Eigen::Index i = 0; i < mesh.F.size(); ++i) mesh.F.data()[i] = new_index[static_cast<std::size_t>(mesh.F.data()[i])];
+  }
+  return mesh;
+}
+
+}  // namespace io_detail
+
+bool is_gzip_path(const std::filesystem::path& path) {
+  std::string ext = path.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext == ".gz";
+}
+
+MeshFormat format_from_path(const std::filesystem::path& path) {
+  std::filesystem::path p = path;
+  if (is_gzip_path(p)) p = p.stem();
+  std::string ext = p.extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  if (ext == ".obj") return MeshFormat::Obj;
+  if (ext == ".ply") return MeshFormat::Ply;
+  if (ext == ".off") return MeshFormat::Off;
+  if (ext == ".stl") return MeshFormat::Stl;
+  io_detail::fail(path.string(), ext.empty() ? "no file extension; expected .obj, .ply, .off or .stl (optionally .gz)"
+                                             : "unknown extension '" + ext + "'; expected .obj, .ply, .off or .stl (optionally .gz)");
+}
+
+std::vector<std::string> ReadReport::warnings() const {
+  std::vector<std::string> out;
+  auto add = [&](std::int64_t count, const char* what) {
+    if (count > 0) out.push_back(fmt::format("{} {}", count, what));
+  };
+  add(polygons_triangulated, "polygons triangulated");
+  add(polygons_fanned, "polygons had no planar triangulation (self-intersecting or folded) and were fanned");
+  add(vertices_welded, "duplicate vertices welded");
+  add(unreferenced_vertices_removed, "unreferenced vertices removed");
+  add(repeated_index_faces_removed, "faces with a repeated vertex removed");
+  add(duplicate_faces_removed, "duplicate faces removed");
+  add(zero_area_faces_removed, "zero-area faces removed");
+  return out;
+}
+
+Mesh read_mesh_from_memory(std::string_view bytes, MeshFormat format, const std::string& name,
+                           ReadReport* report, const ReadOptions& options) {
+  ReadReport local;
+  ReadReport& r = report ? *report : local;
+  r = ReadReport{};
+  r.format = format;
+  std::string inflated;
+  if (io_detail::has_gzip_magic(bytes)) {
+    inflated = io_detail::gunzip(bytes, name, options.max_decompressed_bytes);
+    bytes = inflated;
+    r.gzip = true;
+  }
+  if (bytes.empty()) io_detail::fail(name, "the file is empty");
+  io_detail::PolygonSoup soup;
+  switch (format) {
+    case MeshFormat::Obj: soup = io_detail::parse_obj(bytes, name); break;
+    case MeshFormat::Ply: soup = io_detail::parse_ply(bytes, name, r); break;
+    case MeshFormat::Off: soup = io_detail::parse_off(bytes, name, r); break;
+    case MeshFormat::Stl: soup = io_detail::parse_stl(bytes, name, r); break;
+  }
+  inflated = std::string();  // free the text before building the mesh
+  return io_detail::soup_to_mesh(std::move(soup), name, r, options);
+}
+
+Mesh read_mesh(const std::filesystem::path& path, ReadReport* report, const ReadOptions& options) {
+  const MeshFormat format = format_from_path(path);
+  const std::string bytes = io_detail::read_file_bytes(path);
+  return read_mesh_from_memory(bytes, format, path.string(), report, options);
+}
+
+}  // namespace vertexflow

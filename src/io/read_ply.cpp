@@ -1,0 +1,372 @@
+// PLY reader (ASCII, binary little- and big-endian).
+//
+// Written here because Debian ships no PLY library (tinyply and happly are not packaged) and
+// because the reader must bound its allocations by the file's size: every element count in
+// the header is checked against the bytes that follow before anything is reserved.
+#include "io_internal.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <optional>
+
+namespace vertexflow::io_detail {
+namespace {
+
+enum class Type { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64 };
+
+std::optional<Type> parse_type(std::string_view s) {
+  if (s == "char" || s == "int8") return Type::Int8;
+  if (s == "uchar" || s == "uint8") return Type::UInt8;
+  if (s == "short" || s == "int16") return Type::Int16;
+  if (s == "ushort" || s == "uint16") return Type::UInt16;
+  if (s == "int" || s == "int32") return Type::Int32;
+  if (s == "uint" || s == "uint32") return Type::UInt32;
+  if (s == "float" || s == "float32") return Type::Float32;
+  if (s == "double" || s == "float64") return Type::Float64;
+  return std::nullopt;
+}
+
+std::size_t type_size(Type t) {
+  switch (t) {
+    case Type::Int8: case Type::UInt8: return 1;
+    case Type::Int16: case Type::UInt16: return 2;
+    case Type::Int32: case Type::UInt32: case Type::Float32: return 4;
+    case Type::Float64: return 8;
+  }
+  return 0;
+}
+
+bool is_integer(Type t) { return t != Type::Float32 && t != Type::Float64; }
+
+double load_value(const char* p, Type t, bool swap) {
+  switch (t) {
+    case Type::Int8: return static_cast<std::int8_t>(*p);
+    case Type::UInt8: return static_cast<std::uint8_t>(*p);
+    case Type::Int16: return load_scalar<std::int16_t>(p, swap);
+    case Type::UInt16: return load_scalar<std::uint16_t>(p, swap);
+    case Type::Int32: return load_scalar<std::int32_t>(p, swap);
+    case Type::UInt32: return load_scalar<std::uint32_t>(p, swap);
+    case Type::Float32: return load_scalar<float>(p, swap);
+    case Type::Float64: return load_scalar<double>(p, swap);
+  }
+  return 0;
+}
+
+std::int64_t load_integer(const char* p, Type t, bool swap) {
+  switch (t) {
+    case Type::Int8: return static_cast<std::int8_t>(*p);
+    case Type::UInt8: return static_cast<std::uint8_t>(*p);
+    case Type::Int16: return load_scalar<std::int16_t>(p, swap);
+    case Type::UInt16: return load_scalar<std::uint16_t>(p, swap);
+    case Type::Int32: return load_scalar<std::int32_t>(p, swap);
+    case Type::UInt32: return load_scalar<std::uint32_t>(p, swap);
+    default: return 0;  // list counts and indices are integer types (checked in the header)
+  }
+}
+
+struct Property {
+  std::string name;
+  Type type = Type::Float32;
+  bool is_list = false;
+  Type count_type = Type::UInt8;
+};
+
+struct Element {
+  std::string name;
+  std::uint64_t count = 0;
+  std::vector<Property> properties;
+};
+
+enum class Encoding { Ascii, BinaryLittle, BinaryBig };
+
+// What each vertex property becomes.
+enum class Role { X, Y, Z, Red, Green, Blue, Scalar, Skip };
+
+class PlyParser {
+ public:
+  PlyParser(std::string_view bytes, const std::string& name, ReadReport& report)
+      : bytes_(bytes), name_(name), report_(report) {}
+
+  PolygonSoup parse() {
+    parse_header();
+    for (const Element& element : elements_) {
+      if (element.name == "vertex") {
+        read_vertices(element);
+      } else if (element.name == "face") {
+        read_faces(element);
+      } else {
+        skip_element(element);
+      }
+    }
+    return std::move(soup_);
+  }
+
+ private:
+  void parse_header() {
+    const std::size_t header_end = find_end_header();
+    TextScanner header(bytes_.substr(0, header_end), name_);
+    if (header.token_on_line() != "ply") fail(name_, "not a PLY file (first line must be 'ply')");
+    header.skip_line();
+    bool have_format = false;
+    while (!header.at_end()) {
+      const std::string_view keyword = header.token_on_line();
+      if (keyword.empty() || keyword == "comment" || keyword == "obj_info") {
+      } else if (keyword == "format") {
+        const std::string_view format = header.token_on_line();
+        if (format == "ascii") encoding_ = Encoding::Ascii;
+        else if (format == "binary_little_endian") encoding_ = Encoding::BinaryLittle;
+        else if (format == "binary_big_endian") encoding_ = Encoding::BinaryBig;
+        else header.error("unknown PLY format '" + TextScanner::printable(format) + "'");
+        have_format = true;
+      } else if (keyword == "element") {
+        Element element;
+        element.name = std::string(header.token_on_line());
+        const std::string_view count = header.token_on_line();
+        if (element.name.empty() || count.empty() || count.front() == '-')
+          header.error("malformed element line");
+        element.count = static_cast<std::uint64_t>(header.to_int(count, "an element count"));
+        elements_.push_back(std::move(element));
+      } else if (keyword == "property") {
+        if (elements_.empty()) header.error("property before any element");
+        Property property;
+        std::string_view type = header.token_on_line();
+        if (type == "list") {
+          property.is_list = true;
+          const auto count_type = parse_type(header.token_on_line());
+          if (!count_type || !is_integer(*count_type)) header.error("list count type must be an integer type");
+          property.count_type = *count_type;
+          type = header.token_on_line();
+        }
+        const auto value_type = parse_type(type);
+        if (!value_type) header.error("unknown property type '" + TextScanner::printable(type) + "'");
+        property.type = *value_type;
+        property.name = std::string(header.token_on_line());
+        if (property.name.empty()) header.error("property without a name");
+        elements_.back().properties.push_back(std::move(property));
+      } else if (keyword == "end_header") {
+        break;
+      } else {
+        header.error("unknown header keyword '" + TextScanner::printable(keyword) + "'");
+      }
+      header.skip_line();
+    }
+    if (!have_format) fail(name_, "PLY header has no format line");
+    report_.binary = encoding_ != Encoding::Ascii;
+    swap_ = (encoding_ == Encoding::BinaryBig) == host_is_little_endian();
+    if (std::none_of(elements_.begin(), elements_.end(), [](const Element& e) { return e.name == "vertex"; }))
+      fail(name_, "PLY header declares no vertex element");
+    if (std::none_of(elements_.begin(), elements_.end(), [](const Element& e) { return e.name == "face"; }))
+      fail(name_, "PLY header declares no face element (point clouds are not meshes)");
+  }
+
+  // Returns the offset just past the "end_header" line and positions the body there.
+  std::size_t find_end_header() {
+    if (bytes_.substr(0, 3) != "ply") fail(name_, "not a PLY file (first line must be 'ply')");
+    std::size_t pos = 0;
+    while (pos < bytes_.size()) {
+      std::size_t nl = bytes_.find('\n', pos);
+      if (nl == std::string_view::npos) nl = bytes_.size();
+      std::string_view line = bytes_.substr(pos, nl - pos);
+      if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
+      if (line == "end_header" || line.substr(0, 11) == "end_header ") {
+        body_ = std::min(nl + 1, bytes_.size());
+        return body_;
+      }
+      pos = nl + 1;
+    }
+    fail(name_, "PLY header has no end_header line (truncated file?)");
+  }
+
+  // Bytes one record of `element` needs at least; used to reject counts the file cannot hold.
+  std::uint64_t min_record_bytes(const Element& element) const {
+    std::uint64_t bytes = 0;
+    for (const Property& p : element.properties) {
+      if (encoding_ == Encoding::Ascii) bytes += 2;  // one character and a separator
+      else bytes += type_size(p.is_list ? p.count_type : p.type);
+    }
+    return bytes;
+  }
+
+  void check_count(const Element& element) const {
+    const std::uint64_t min_bytes = min_record_bytes(element);
+    const std::uint64_t available = bytes_.size() - body_;
+    if (min_bytes > 0 && element.count > (available + 1) / min_bytes)
+      fail(name_, fmt::format("header declares {} '{}' elements, but the remaining {} bytes can hold at most {}",
+                              element.count, element.name, available, (available + 1) / min_bytes));
+  }
+
+  // --- value access: ASCII tokens or binary bytes, advancing body_ ---
+  double next_value(Type type, const char* what) {
+    if (encoding_ == Encoding::Ascii) return ascii().next_double(what);
+    const std::size_t size = type_size(type);
+    if (body_ + size > bytes_.size()) truncated(what);
+    const double v = load_value(bytes_.data() + body_, type, swap_);
+    body_ += size;
+    return v;
+  }
+  std::int64_t next_integer(Type type, const char* what) {
+    if (encoding_ == Encoding::Ascii) {
+      const double v = ascii().next_double(what);
+      if (v != std::floor(v) || std::abs(v) > 9e15) ascii().error(fmt::format("expected an integer {}", what));
+      return static_cast<std::int64_t>(v);
+    }
+    const std::size_t size = type_size(type);
+    if (body_ + size > bytes_.size()) truncated(what);
+    const std::int64_t v = load_integer(bytes_.data() + body_, type, swap_);
+    body_ += size;
+    return v;
+  }
+  std::uint64_t next_list_count(const Property& p) {
+    const std::int64_t n = next_integer(p.count_type, "list length");
+    const std::uint64_t available = bytes_.size() - position();
+    const std::uint64_t item = encoding_ == Encoding::Ascii ? 2 : type_size(p.type);
+    if (n < 0 || static_cast<std::uint64_t>(n) > (available + 1) / item)
+      fail(name_, fmt::format("invalid list length {} for property '{}' at byte {}", n, p.name, body_));
+    return static_cast<std::uint64_t>(n);
+  }
+  void skip_property(const Property& p) {
+    if (!p.is_list) {
+      next_value(p.type, "a property value");
+      return;
+    }
+    const std::uint64_t n = next_list_count(p);
+    for (std::uint64_t i = 0; i < n; ++i) next_value(p.type, "a list item");
+  }
+  [[noreturn]] void truncated(const char* what) const {
+    fail(name_, fmt::format("unexpected end of file while reading {} (file truncated?)", what));
+  }
+  // ASCII body scanning shares body_ through a scanner positioned at it.
+  TextScanner& ascii() {
+    if (!scanner_) {
+      scanner_.emplace(bytes_, name_);
+      scanner_->advance(body_);
+    }
+    return *scanner_;
+  }
+
+  void read_vertices(const Element& element) {
+    check_count(element);
+    std::vector<Role> roles;
+    std::vector<std::size_t> scalar_slot;
+    bool has[3] = {false, false, false};
+    int color_channels = 0;
+    for (const Property& p : element.properties) {
+      Role role = Role::Skip;
+      if (!p.is_list) {
+        if (p.name == "x") role = Role::X, has[0] = true;
+        else if (p.name == "y") role = Role::Y, has[1] = true;
+        else if (p.name == "z") role = Role::Z, has[2] = true;
+        else if (p.type == Type::UInt8 && (p.name == "red" || p.name == "green" || p.name == "blue")) {
+          role = p.name == "red" ? Role::Red : p.name == "green" ? Role::Green : Role::Blue;
+          ++color_channels;
+        } else if (p.type != Type::UInt8 || p.name != "alpha") {
+          role = Role::Scalar;
+        }
+      }
+      roles.push_back(role);
+    }
+    if (!has[0] || !has[1] || !has[2]) fail(name_, "vertex element lacks an x, y or z property");
+    const std::size_t n = static_cast<std::size_t>(element.count);
+    soup_.xyz.resize(3 * n);
+    if (color_channels == 3) soup_.rgb.resize(3 * n);
+    for (std::size_t i = 0; i < element.properties.size(); ++i) {
+      if (roles[i] == Role::Scalar) {
+        scalar_slot.push_back(soup_.properties.size());
+        soup_.properties.push_back({element.properties[i].name, Eigen::VectorXd(static_cast<Eigen::Index>(n))});
+      } else {
+        scalar_slot.push_back(0);
+      }
+    }
+    for (std::size_t v = 0; v < n; ++v) {
+      for (std::size_t i = 0; i < element.properties.size(); ++i) {
+        const Property& p = element.properties[i];
+        switch (roles[i]) {
+          case Role::X: case Role::Y: case Role::Z:
+            soup_.xyz[3 * v + static_cast<std::size_t>(roles[i])] = next_value(p.type, "a vertex coordinate");
+            break;
+          case Role::Red: case Role::Green: case Role::Blue: {
+            const double c = next_value(p.type, "a vertex colour");
+            if (!soup_.rgb.empty()) soup_.rgb[3 * v + static_cast<std::size_t>(roles[i]) - 3] = static_cast<std::uint8_t>(c);
+            break;
+          }
+          case Role::Scalar:
+            soup_.properties[scalar_slot[i]].values[static_cast<Eigen::Index>(v)] = next_value(p.type, "a vertex property");
+            break;
+          case Role::Skip:
+            skip_property(p);
+            break;
+        }
+      }
+    }
+    sync_ascii();
+  }
+
+  void read_faces(const Element& element) {
+    check_count(element);
+    std::size_t index_property = element.properties.size();
+    for (std::size_t i = 0; i < element.properties.size(); ++i) {
+      const Property& p = element.properties[i];
+      if (p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index")) index_property = i;
+    }
+    if (index_property == element.properties.size())
+      fail(name_, "face element has no 'vertex_indices' list property");
+    if (!is_integer(element.properties[index_property].type))
+      fail(name_, "face vertex indices must have an integer type");
+    const std::size_t n = static_cast<std::size_t>(element.count);
+    soup_.offsets.reserve(n + 1);
+    soup_.corners.reserve(3 * n);
+    for (std::size_t f = 0; f < n; ++f) {
+      for (std::size_t i = 0; i < element.properties.size(); ++i) {
+        const Property& p = element.properties[i];
+        if (i != index_property) {
+          skip_property(p);
+          continue;
+        }
+        const std::uint64_t count = next_list_count(p);
+        for (std::uint64_t k = 0; k < count; ++k) {
+          const std::int64_t index = next_integer(p.type, "a face vertex index");
+          if (index < 0 || index > std::numeric_limits<Index>::max())
+            fail(name_, fmt::format("face {} has invalid vertex index {}", f, index));
+          soup_.corners.push_back(static_cast<Index>(index));
+        }
+      }
+      soup_.end_polygon();
+    }
+    sync_ascii();
+  }
+
+  void skip_element(const Element& element) {
+    check_count(element);
+    if (element.properties.empty()) return;
+    for (std::uint64_t r = 0; r < element.count; ++r) {
+      for (const Property& p : element.properties) skip_property(p);
+    }
+    sync_ascii();
+  }
+
+  std::size_t position() const { return scanner_ ? scanner_->position() : body_; }
+
+  // After an ASCII element, keep body_ in step with the scanner (used by the count checks).
+  void sync_ascii() {
+    if (scanner_) body_ = scanner_->position();
+  }
+
+  std::string_view bytes_;
+  const std::string& name_;
+  ReadReport& report_;
+  std::vector<Element> elements_;
+  Encoding encoding_ = Encoding::Ascii;
+  bool swap_ = false;
+  std::size_t body_ = 0;
+  std::optional<TextScanner> scanner_;
+  PolygonSoup soup_;
+};
+
+}  // namespace
+
+PolygonSoup parse_ply(std::string_view bytes, const std::string& name, ReadReport& report) {
+  return PlyParser(bytes, name, report).parse();
+}
+
+}  // namespace vertexflow::io_detail

@@ -1,0 +1,44 @@
+#include "vertexflow/mesh.h"
+
+#include <Eigen/Geometry>
+
+#include <stdexcept>
+
+namespace vertexflow {
+
+void Mesh::set_vertex_property(std::string name, Eigen::VectorXd values) {
+  if (values.size() != V.rows())
+    throw std::invalid_argument("vertex property '" + name + "' has " + std::to_string(values.size()) +
+                                " values for " + std::to_string(V.rows()) + " vertices");
+  for (auto& p : vertex_properties) {
+    if (p.name == name) {
+      p.values = std::move(values);
+      return;
+    }
+  }
+  vertex_properties.push_back({std::move(name), std::move(values)});
+}
+
+const VertexProperty* Mesh::find_vertex_property(std::string_view name) const {
+  for (const auto& p : vertex_properties) {
+    if (p.name == name) return &p;
+  }
+  return nullptr;
+}
+
+BoundingBox bounding_box(const Vertices& V) {
+  BoundingBox box;
+  if (V.rows() == 0) return box;
+  box.min = V.colwise().minCoeff().transpose();
+  box.max = V.colwise().maxCoeff().transpose();
+  return box;
+}
+
+double face_area(const Vertices& V, const Faces& F, Index f) {
+  const Eigen::Vector3d a = V.row(F(f, 0));
+  const Eigen::Vector3d b = V.row(F(f, 1));
+  const Eigen::Vector3d c = V.row(F(f, 2));
+  return 0.5 * (b - a).cross(c - a).norm();
+}
+
+}  // namespace vertexflow

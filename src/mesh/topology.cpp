@@ -1,0 +1,340 @@
+#include "vertexflow/topology.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+
+namespace vertexflow {
+namespace {
+
+template <class Body>
+void parallel_vertices(Index n, Body&& body) {
+  tbb::parallel_for(tbb::blocked_range<Index>(0, n, 4096), [&](const tbb::blocked_range<Index>& r) {
+    std::vector<Index> scratch;
+    for (Index v = r.begin(); v != r.end(); ++v) body(v, scratch);
+  });
+}
+
+// Exclusive prefix sum of counts into offsets (size n + 1).
+std::vector<Index> offsets_from_counts(const std::vector<Index>& counts) {
+  std::vector<Index> offsets(counts.size() + 1, 0);
+  std::inclusive_scan(counts.begin(), counts.end(), offsets.begin() + 1);
+  return offsets;
+}
+
+struct UnionFind {
+  std::vector<Index> parent;
+  explicit UnionFind(Index n) : parent(static_cast<std::size_t>(n)) { std::iota(parent.begin(), parent.end(), 0); }
+  Index find(Index x) {
+    while (parent[static_cast<std::size_t>(x)] != x) {
+      parent[static_cast<std::size_t>(x)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
+      x = parent[static_cast<std::size_t>(x)];
+    }
+    return x;
+  }
+  void unite(Index a, Index b) {
+    a = find(a), b = find(b);
+    if (a != b) parent[static_cast<std::size_t>(std::max(a, b))] = std::min(a, b);
+  }
+};
+
+// Orders the one-ring of a vertex from its incident faces. Each incident face contributes a
+// wedge (next corner, previous corner); at a manifold vertex the wedges chain into one path
+// (boundary) or one cycle. Returns false if they do not (non-manifold vertex).
+bool order_one_ring(Index v, const Faces& F, Index* faces, Index count, Index* ring, Index ring_size) {
+  // Per-thread buffers: this runs once per vertex, so no allocation per call.
+  thread_local std::vector<std::pair<Index, Index>> incidence_buffer;
+  thread_local std::vector<Index> ordered_faces;
+  thread_local std::vector<Index> check;
+  // Wedge w spans link vertices a(w) -> b(w).
+  auto corner = [&](Index f) {
+    return F(f, 0) == v ? 0 : F(f, 1) == v ? 1 : 2;
+  };
+  auto a_of = [&](Index f) { return F(f, (corner(f) + 1) % 3); };
+  auto b_of = [&](Index f) { return F(f, (corner(f) + 2) % 3); };
+
+  // Incidence list of the link graph: (link vertex, wedge), sorted by link vertex.
+  incidence_buffer.resize(2 * static_cast<std::size_t>(count));
+  std::pair<Index, Index>* incidence = incidence_buffer.data();
+  for (Index w = 0; w < count; ++w) {
+    incidence[2 * w] = {a_of(faces[w]), w};
+    incidence[2 * w + 1] = {b_of(faces[w]), w};
+  }
+  std::sort(incidence, incidence + 2 * count);
+  // Every link vertex must be in one or two wedges; count the path ends.
+  Index ends = 0;
+  for (Index i = 0; i < 2 * count;) {
+    Index j = i;
+    while (j < 2 * count && incidence[j].first == incidence[i].first) ++j;
+    if (j - i > 2) return false;
+    if (j - i == 1) ++ends;
+    i = j;
+  }
+  if (ends != 0 && ends != 2) return false;
+  const Index expected_ring = ends == 0 ? count : count + 1;
+  if (expected_ring != ring_size) return false;
+
+  auto other_wedge = [&](Index link_vertex, Index wedge) -> Index {
+    const auto* it = std::lower_bound(incidence, incidence + 2 * count, std::make_pair(link_vertex, Index{-1}));
+    for (; it != incidence + 2 * count && it->first == link_vertex; ++it) {
+      if (it->second != wedge) return it->second;
+    }
+    return -1;
+  };
+  auto degree = [&](Index link_vertex) {
+    const auto* lo = std::lower_bound(incidence, incidence + 2 * count, std::make_pair(link_vertex, Index{-1}));
+    Index d = 0;
+    for (; lo != incidence + 2 * count && lo->first == link_vertex; ++lo) ++d;
+    return d;
+  };
+
+  // Start: on a path, at the end that is the 'a' of its wedge, so the walk follows the faces'
+  // orientation when it is consistent; on a cycle, at wedge 0.
+  Index start_wedge = 0;
+  Index start_vertex = a_of(faces[0]);
+  if (ends == 2) {
+    start_wedge = -1;
+    for (Index w = 0; w < count && start_wedge < 0; ++w) {
+      if (degree(a_of(faces[w])) == 1) start_wedge = w, start_vertex = a_of(faces[w]);
+    }
+    if (start_wedge < 0) {  // inconsistent orientation: start at a 'b' end instead
+      for (Index w = 0; w < count && start_wedge < 0; ++w) {
+        if (degree(b_of(faces[w])) == 1) start_wedge = w, start_vertex = b_of(faces[w]);
+      }
+    }
+  }
+  ordered_faces.clear();
+  Index wedge = start_wedge;
+  Index current = start_vertex;
+  Index filled = 0;
+  ring[filled++] = current;
+  for (Index step = 0; step < count; ++step) {
+    const Index f = faces[wedge];
+    ordered_faces.push_back(f);
+    const Index a = a_of(f), b = b_of(f);
+    current = current == a ? b : a;
+    if (step + 1 < count || ends == 2) {
+      if (filled >= ring_size) return false;
+      ring[filled++] = current;
+    }
+    if (step + 1 < count) {
+      wedge = other_wedge(current, wedge);
+      if (wedge < 0) return false;  // the chain broke: more than one fan
+    }
+  }
+  if (ends == 0 && current != start_vertex) return false;
+  // Every wedge visited exactly once?
+  check.assign(ordered_faces.begin(), ordered_faces.end());
+  std::sort(check.begin(), check.end());
+  if (std::adjacent_find(check.begin(), check.end()) != check.end()) return false;
+  std::copy(ordered_faces.begin(), ordered_faces.end(), faces);
+  return filled == ring_size;
+}
+
+}  // namespace
+
+std::int64_t Topology::genus() const {
+  if (!is_manifold() || !is_oriented) return -1;
+  // Components that carry faces; isolated vertices are not surfaces.
+  std::vector<char> has_face(static_cast<std::size_t>(num_components), 0);
+  for (const Index c : face_component) has_face[static_cast<std::size_t>(c)] = 1;
+  std::int64_t surfaces = std::count(has_face.begin(), has_face.end(), 1);
+  std::int64_t isolated = 0;
+  for (Index v = 0; v < num_vertices; ++v) isolated += face_offsets[v + 1] == face_offsets[v];
+  const std::int64_t chi = euler_characteristic() - isolated;
+  const std::int64_t twice = 2 * surfaces - static_cast<std::int64_t>(boundary_loops.size()) - chi;
+  return twice >= 0 && twice % 2 == 0 ? twice / 2 : -1;
+}
+
+Topology build_topology(const Faces& F, Index num_vertices) {
+  Topology t;
+  t.num_vertices = num_vertices;
+  t.num_faces = static_cast<Index>(F.rows());
+  const Index nv = num_vertices;
+  const Index nf = t.num_faces;
+  if (nf > 0 && (F.minCoeff() < 0 || F.maxCoeff() >= nv))
+    throw std::invalid_argument("build_topology: a face index is outside [0, " + std::to_string(nv) + ")");
+
+  // Vertex -> faces (counting sort, faces in increasing order per vertex).
+  {
+    std::vector<Index> counts(static_cast<std::size_t>(nv), 0);
+    for (Eigen::Index i = 0; i < F.size(); ++i) ++counts[static_cast<std::size_t>(F.data()[i])];
+    t.face_offsets = offsets_from_counts(counts);
+    t.vertex_faces.resize(static_cast<std::size_t>(3) * static_cast<std::size_t>(nf));
+    std::vector<Index> fill(t.face_offsets.begin(), t.face_offsets.end() - 1);
+    for (Index f = 0; f < nf; ++f) {
+      for (int k = 0; k < 3; ++k) t.vertex_faces[static_cast<std::size_t>(fill[static_cast<std::size_t>(F(f, k))]++)] = f;
+    }
+  }
+  auto incident_faces = [&](Index v) {
+    return std::pair{t.vertex_faces.data() + t.face_offsets[v], t.vertex_faces.data() + t.face_offsets[v + 1]};
+  };
+
+  // Undirected edges owned by their smaller vertex: neighbours w > v, sorted. Two passes
+  // (count, then fill) so the edge list comes out sorted without a global sort.
+  auto larger_neighbours = [&](Index v, std::vector<Index>& out) {
+    out.clear();
+    const auto [begin, end] = incident_faces(v);
+    for (const Index* f = begin; f != end; ++f) {
+      for (int k = 0; k < 3; ++k) {
+        if (F(*f, k) > v) out.push_back(F(*f, k));
+      }
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+  };
+  std::vector<Index> edge_counts(static_cast<std::size_t>(nv));
+  parallel_vertices(nv, [&](Index v, std::vector<Index>& scratch) {
+    larger_neighbours(v, scratch);
+    edge_counts[static_cast<std::size_t>(v)] = static_cast<Index>(scratch.size());
+  });
+  const std::vector<Index> edge_offsets = offsets_from_counts(edge_counts);
+  const Index ne = edge_offsets.back();
+  t.edges.resize(ne, 2);
+  parallel_vertices(nv, [&](Index v, std::vector<Index>& scratch) {
+    larger_neighbours(v, scratch);
+    Index e = edge_offsets[static_cast<std::size_t>(v)];
+    for (const Index w : scratch) t.edges(e, 0) = v, t.edges(e, 1) = w, ++e;
+  });
+  auto find_edge = [&](Index a, Index b) {
+    if (a > b) std::swap(a, b);
+    const Index* first = t.edges.data() + 2 * edge_offsets[static_cast<std::size_t>(a)];
+    for (Index e = edge_offsets[static_cast<std::size_t>(a)]; e < edge_offsets[static_cast<std::size_t>(a) + 1]; ++e, first += 2) {
+      if (first[1] == b) return e;
+    }
+    return Index{-1};  // unreachable: every face edge was recorded above
+  };
+
+  // Face -> edges, edge -> faces.
+  t.face_edges.resize(nf, 3);
+  tbb::parallel_for(tbb::blocked_range<Index>(0, nf, 4096), [&](const tbb::blocked_range<Index>& r) {
+    for (Index f = r.begin(); f != r.end(); ++f) {
+      for (int k = 0; k < 3; ++k) t.face_edges(f, k) = find_edge(F(f, k), F(f, (k + 1) % 3));
+    }
+  });
+  t.edge_face_count.assign(static_cast<std::size_t>(ne), 0);
+  std::vector<Index> edge_face(2 * static_cast<std::size_t>(ne), -1);
+  for (Index f = 0; f < nf; ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const auto e = static_cast<std::size_t>(t.face_edges(f, k));
+      const Index seen = t.edge_face_count[e]++;
+      if (seen < 2) edge_face[2 * e + static_cast<std::size_t>(seen)] = f;
+    }
+  }
+  t.face_adjacency.resize(nf, 3);
+  for (Index f = 0; f < nf; ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const auto e = static_cast<std::size_t>(t.face_edges(f, k));
+      Index other = -1;
+      if (t.edge_face_count[e] == 2) {
+        other = edge_face[2 * e] == f ? edge_face[2 * e + 1] : edge_face[2 * e];
+        // Consistent orientation: the neighbour runs the shared edge the other way.
+        const Index a = F(f, k), b = F(f, (k + 1) % 3);
+        for (int j = 0; j < 3; ++j) {
+          if (F(other, j) == a && F(other, (j + 1) % 3) == b) t.is_oriented = false;
+        }
+      }
+      t.face_adjacency(f, k) = other;
+    }
+  }
+  for (Index e = 0; e < ne; ++e) {
+    if (t.edge_face_count[static_cast<std::size_t>(e)] > 2) t.non_manifold_edges.push_back(e);
+  }
+
+  // One-rings: valence is the number of incident edges.
+  {
+    std::vector<Index> valence(static_cast<std::size_t>(nv), 0);
+    for (Index e = 0; e < ne; ++e) ++valence[static_cast<std::size_t>(t.edges(e, 0))], ++valence[static_cast<std::size_t>(t.edges(e, 1))];
+    t.ring_offsets = offsets_from_counts(valence);
+  }
+  t.ring_vertices.resize(static_cast<std::size_t>(t.ring_offsets.back()));
+  t.is_manifold_vertex.assign(static_cast<std::size_t>(nv), 1);
+  t.is_boundary_vertex.assign(static_cast<std::size_t>(nv), 0);
+  for (Index e = 0; e < ne; ++e) {
+    if (t.edge_face_count[static_cast<std::size_t>(e)] == 1)
+      t.is_boundary_vertex[static_cast<std::size_t>(t.edges(e, 0))] = t.is_boundary_vertex[static_cast<std::size_t>(t.edges(e, 1))] = 1;
+  }
+  parallel_vertices(nv, [&](Index v, std::vector<Index>& scratch) {
+    Index* ring = t.ring_vertices.data() + t.ring_offsets[static_cast<std::size_t>(v)];
+    const Index ring_size = t.ring_offsets[static_cast<std::size_t>(v) + 1] - t.ring_offsets[static_cast<std::size_t>(v)];
+    Index* faces = t.vertex_faces.data() + t.face_offsets[static_cast<std::size_t>(v)];
+    const Index count = t.face_offsets[static_cast<std::size_t>(v) + 1] - t.face_offsets[static_cast<std::size_t>(v)];
+    if (count == 0) return;  // isolated vertex: manifold in the trivial sense, empty ring
+    if (order_one_ring(v, F, faces, count, ring, ring_size)) return;
+    t.is_manifold_vertex[static_cast<std::size_t>(v)] = 0;
+    std::sort(faces, faces + count);
+    Index filled = 0;
+    for (Index e = edge_offsets[static_cast<std::size_t>(v)]; e < edge_offsets[static_cast<std::size_t>(v) + 1]; ++e) ring[filled++] = t.edges(e, 1);
+    // Smaller neighbours own the edge: scan incident faces for them.
+    scratch.clear();
+    for (Index i = 0; i < count; ++i) {
+      for (int k = 0; k < 3; ++k) {
+        if (F(faces[i], k) < v) scratch.push_back(F(faces[i], k));
+      }
+    }
+    std::sort(scratch.begin(), scratch.end());
+    scratch.erase(std::unique(scratch.begin(), scratch.end()), scratch.end());
+    for (const Index w : scratch) ring[filled++] = w;
+    std::sort(ring, ring + ring_size);
+  });
+  for (Index v = 0; v < nv; ++v) {
+    if (!t.is_manifold_vertex[static_cast<std::size_t>(v)]) t.non_manifold_vertices.push_back(v);
+  }
+
+  // Boundary loops: walk boundary half-edges (face edges reversed) from vertex to vertex.
+  {
+    std::vector<Index> out_count(static_cast<std::size_t>(nv), 0);
+    std::vector<std::pair<Index, Index>> half_edges;  // (from, to), reversed face order
+    for (Index f = 0; f < nf; ++f) {
+      for (int k = 0; k < 3; ++k) {
+        if (t.edge_face_count[static_cast<std::size_t>(t.face_edges(f, k))] == 1)
+          half_edges.emplace_back(F(f, (k + 1) % 3), F(f, k));
+      }
+    }
+    std::sort(half_edges.begin(), half_edges.end());
+    std::vector<char> used(half_edges.size(), 0);
+    auto first_out = [&](Index from) {
+      return std::lower_bound(half_edges.begin(), half_edges.end(), std::make_pair(from, Index{-1})) - half_edges.begin();
+    };
+    for (std::size_t h0 = 0; h0 < half_edges.size(); ++h0) {
+      if (used[h0]) continue;
+      std::vector<Index> loop;
+      std::size_t h = h0;
+      for (;;) {
+        used[h] = 1;
+        loop.push_back(half_edges[h].first);
+        const Index to = half_edges[h].second;
+        if (to == half_edges[h0].first) break;
+        std::ptrdiff_t next = first_out(to);
+        while (next < static_cast<std::ptrdiff_t>(half_edges.size()) && half_edges[static_cast<std::size_t>(next)].first == to &&
+               used[static_cast<std::size_t>(next)])
+          ++next;
+        if (next >= static_cast<std::ptrdiff_t>(half_edges.size()) || half_edges[static_cast<std::size_t>(next)].first != to) break;
+        h = static_cast<std::size_t>(next);
+      }
+      t.boundary_loops.push_back(std::move(loop));
+    }
+  }
+
+  // Connected components (vertices joined by faces), numbered in order of first vertex.
+  {
+    UnionFind sets(nv);
+    for (Index f = 0; f < nf; ++f) sets.unite(F(f, 0), F(f, 1)), sets.unite(F(f, 1), F(f, 2));
+    t.vertex_component.assign(static_cast<std::size_t>(nv), -1);
+    std::vector<Index> label(static_cast<std::size_t>(nv), -1);
+    for (Index v = 0; v < nv; ++v) {
+      Index& l = label[static_cast<std::size_t>(sets.find(v))];
+      if (l < 0) l = t.num_components++;
+      t.vertex_component[static_cast<std::size_t>(v)] = l;
+    }
+    t.face_component.resize(static_cast<std::size_t>(nf));
+    for (Index f = 0; f < nf; ++f) t.face_component[static_cast<std::size_t>(f)] = t.vertex_component[static_cast<std::size_t>(F(f, 0))];
+  }
+  return t;
+}
+
+}  // namespace vertexflow

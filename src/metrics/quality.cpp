@@ -1,0 +1,41 @@
+#include "vertexflow/quality.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace vertexflow {
+
+Eigen::VectorXd triangle_quality(const Vertices& V, const Faces& F) {
+  Eigen::VectorXd q(F.rows());
+  for (Eigen::Index f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d p0 = V.row(F(f, 0)), p1 = V.row(F(f, 1)), p2 = V.row(F(f, 2));
+    const double a = (p1 - p2).norm(), b = (p2 - p0).norm(), c = (p0 - p1).norm();
+    const double denominator = a * b * c;
+    const double value = denominator > 0 ? (b + c - a) * (c + a - b) * (a + b - c) / denominator : 0.0;
+    q[f] = std::clamp(value, 0.0, 1.0);
+  }
+  return q;
+}
+
+QualityStats summarize_quality(const Eigen::VectorXd& quality) {
+  QualityStats s;
+  const Eigen::Index n = quality.size();
+  if (n == 0) return s;
+  s.min = quality.minCoeff();
+  s.mean = quality.mean();
+  std::int64_t below = 0;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    below += quality[i] < 0.3;
+    const auto bin = std::clamp<std::int64_t>(static_cast<std::int64_t>(std::floor(quality[i] * 10)), 0, 9);
+    ++s.histogram[static_cast<std::size_t>(bin)];
+  }
+  s.fraction_below_0_3 = static_cast<double>(below) / static_cast<double>(n);
+  std::vector<double> sorted(quality.data(), quality.data() + n);
+  const auto rank = static_cast<std::size_t>(std::ceil(0.05 * static_cast<double>(n))) - 1;
+  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(std::min(rank, sorted.size() - 1)), sorted.end());
+  s.p5 = sorted[std::min(rank, sorted.size() - 1)];
+  return s;
+}
+
+}  // namespace vertexflow
