@@ -1,0 +1,254 @@
+// Every bundled mesh reads with the counts its provenance lists, and our readers agree with an
+// independent implementation (CGAL's polygon-soup readers) vertex for vertex.
+#include "test_support.h"
+
+#include "vertexflow/io.h"
+
+#include <CGAL/IO/polygon_soup_io.h>
+#include <CGAL/Simple_cartesian.h>
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <vector>
+
+namespace vertexflow {
+namespace {
+
+using test::data_path;
+
+struct Expected {
+  const char* file;
+  Index vertices;
+  Index faces;  // triangles after triangulation
+  std::int64_t polygons_triangulated;
+  friend void PrintTo(const Expected& e, std::ostream* os) { *os << e.file; }
+};
+
+// data/README.md lists V and F; polygon files have F = triangles after splitting
+// (fandisk_quads: 764 quads -> 1528; chamfer-cube: 18 quads + 8 triangles -> 44;
+// suzanne: 468 quads + 32 triangles -> 968).
+const Expected kBundled[] = {
+    {"bunny.off", 34835, 69666, 0},          {"bunny_uniform.off", 8904, 17804, 0},
+    {"bunny_adaptive.off", 5884, 11764, 0},  {"amo.off", 90112, 180220, 0},
+    {"amo_adaptive.off", 5677, 11350, 0},    {"fandisk.off", 6475, 12946, 0},
+    {"fandisk_quads.off", 766, 1528, 764},   {"chamfer-cube.off", 24, 44, 18},
+    {"hemisphere.off", 1861, 3600, 0},       {"sphere.off", 16070, 32136, 0},
+    {"sphere_low.off", 589, 1174, 0},        {"icosahedron_ascii.stl", 12, 20, 0},
+    {"icosahedron_binary.stl", 12, 20, 0},   {"suzanne.obj", 507, 968, 468},
+    {"max-planck-5k.obj", 5272, 10540, 0},   {"armadillo-43k.obj", 43243, 86482, 0},
+    {"camelhead.off", 11381, 22704, 0},      {"fertility.off", 4494, 9000, 0},
+    {"torus.obj", 2304, 4608, 0},            {"horse-48k.ply", 48485, 96966, 0},
+    {"rocker-arm.obj", 10044, 20088, 0},     {"spot.obj", 2930, 5856, 0},
+};
+
+class BundledMesh : public ::testing::TestWithParam<Expected> {};
+
+TEST_P(BundledMesh, ReadsWithExpectedCounts) {
+  const Expected& e = GetParam();
+  ReadReport report;
+  const Mesh mesh = read_mesh(data_path(e.file), &report);
+  EXPECT_EQ(mesh.num_vertices(), e.vertices);
+  EXPECT_EQ(mesh.num_faces(), e.faces);
+  EXPECT_EQ(report.polygons_triangulated, e.polygons_triangulated);
+  EXPECT_EQ(report.polygons_fanned, 0);
+  EXPECT_EQ(report.duplicate_faces_removed, 0);
+  EXPECT_EQ(report.unreferenced_vertices_removed, 0);
+  EXPECT_TRUE(mesh.V.allFinite());
+  EXPECT_GE(mesh.F.minCoeff(), 0);
+  EXPECT_LT(mesh.F.maxCoeff(), mesh.num_vertices());
+}
+
+INSTANTIATE_TEST_SUITE_P(Data, BundledMesh, ::testing::ValuesIn(kBundled),
+                         [](const auto& param_info) { return test::test_name(param_info.param.file); });
+
+TEST(ReadMesh, FormatsAreDetected) {
+  ReadReport report;
+  read_mesh(data_path("amo.off"), &report);
+  EXPECT_EQ(report.format, MeshFormat::Off);
+  EXPECT_TRUE(report.binary);
+  read_mesh(data_path("horse-48k.ply"), &report);
+  EXPECT_EQ(report.format, MeshFormat::Ply);
+  EXPECT_TRUE(report.binary);
+  read_mesh(data_path("icosahedron_ascii.stl"), &report);
+  EXPECT_FALSE(report.binary);
+  EXPECT_EQ(report.vertices_welded, 60 - 12);
+  read_mesh(data_path("icosahedron_binary.stl"), &report);
+  EXPECT_TRUE(report.binary);
+  EXPECT_EQ(report.vertices_welded, 60 - 12);
+}
+
+TEST(ReadMesh, PlyVertexPropertiesAreKept) {
+  // horse-48k.ply carries normals nx, ny, nz as float properties.
+  const Mesh mesh = read_mesh(data_path("horse-48k.ply"));
+  const VertexProperty* nx = mesh.find_vertex_property("nx");
+  ASSERT_NE(nx, nullptr);
+  ASSERT_EQ(nx->values.size(), mesh.num_vertices());
+  const VertexProperty* ny = mesh.find_vertex_property("ny");
+  const VertexProperty* nz = mesh.find_vertex_property("nz");
+  ASSERT_NE(ny, nullptr);
+  ASSERT_NE(nz, nullptr);
+  // The stored normals (not normalised in this file) point like the area-weighted face normals.
+  Vertices face_normal_sum = Vertices::Zero(mesh.num_vertices(), 3);
+  for (Index f = 0; f < mesh.num_faces(); ++f) {
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)), c = mesh.V.row(mesh.F(f, 2));
+    const Eigen::RowVector3d n = (b - a).cross(c - a).transpose();
+    for (int k = 0; k < 3; ++k) face_normal_sum.row(mesh.F(f, k)) += n;
+  }
+  Index agreeing = 0;
+  for (Index v = 0; v < mesh.num_vertices(); ++v) {
+    const Eigen::Vector3d stored(nx->values[v], ny->values[v], nz->values[v]);
+    agreeing += stored.normalized().dot(face_normal_sum.row(v).normalized()) > 0.9;
+  }
+  EXPECT_GT(agreeing, 0.99 * mesh.num_vertices());
+}
+
+// CGAL's readers are an independent implementation of the same formats: for triangle files
+// (where no triangulation is involved) both must give the same positions and faces.
+class AgreesWithCgal : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(AgreesWithCgal, SameVerticesAndFaces) {
+  using Point = CGAL::Simple_cartesian<double>::Point_3;
+  std::vector<Point> points;
+  std::vector<std::vector<std::size_t>> polygons;
+  ASSERT_TRUE(CGAL::IO::read_polygon_soup(data_path(GetParam()).string(), points, polygons));
+  const Mesh mesh = read_mesh(data_path(GetParam()));
+  ASSERT_EQ(static_cast<std::size_t>(mesh.num_vertices()), points.size());
+  ASSERT_EQ(static_cast<std::size_t>(mesh.num_faces()), polygons.size());
+  for (Index v = 0; v < mesh.num_vertices(); ++v) {
+    for (int c = 0; c < 3; ++c) ASSERT_EQ(mesh.V(v, c), points[static_cast<std::size_t>(v)][c]) << "vertex " << v;
+  }
+  for (Index f = 0; f < mesh.num_faces(); ++f) {
+    ASSERT_EQ(polygons[static_cast<std::size_t>(f)].size(), 3u);
+    for (int c = 0; c < 3; ++c)
+      ASSERT_EQ(static_cast<std::size_t>(mesh.F(f, c)), polygons[static_cast<std::size_t>(f)][static_cast<std::size_t>(c)]);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Data, AgreesWithCgal,
+                         ::testing::Values("bunny_uniform.off", "fandisk.off", "horse-48k.ply", "spot.obj",
+                                           "max-planck-5k.obj"),
+                         [](const auto& param_info) { return test::test_name(param_info.param); });
+
+// --- cleanup and triangulation on small in-memory files ---
+
+Mesh read_text(const std::string& text, MeshFormat format, ReadReport* report = nullptr) {
+  return read_mesh_from_memory(text, format, "memory", report);
+}
+
+TEST(Cleanup, RemovesUnreferencedDuplicateRepeatedAndZeroAreaFaces) {
+  const std::string obj =
+      "v 0 0 0\n"   // 1
+      "v 9 9 9\n"   // 2: unreferenced
+      "v 1 0 0\n"   // 3
+      "v 0 1 0\n"   // 4
+      "v 2 0 0\n"   // 5: collinear with 1 and 3
+      "f 1 3 4\n"
+      "f 4 3 1\n"   // duplicate with the opposite orientation
+      "f 3 1 4\n"   // duplicate (rotation)
+      "f 1 1 4\n"   // repeated index
+      "f 1 3 5\n";  // zero area
+  ReadReport report;
+  const Mesh mesh = read_text(obj, MeshFormat::Obj, &report);
+  ASSERT_EQ(mesh.num_faces(), 1);
+  EXPECT_EQ(report.duplicate_faces_removed, 2);
+  EXPECT_EQ(report.repeated_index_faces_removed, 1);
+  EXPECT_EQ(report.zero_area_faces_removed, 1);
+  // Vertices 2 and 5 (1-based) are unreferenced after cleanup; the others keep their order.
+  EXPECT_EQ(report.unreferenced_vertices_removed, 2);
+  ASSERT_EQ(mesh.num_vertices(), 3);
+  EXPECT_EQ(mesh.V.row(0), Eigen::RowVector3d(0, 0, 0));
+  EXPECT_EQ(mesh.V.row(1), Eigen::RowVector3d(1, 0, 0));
+  EXPECT_EQ(mesh.V.row(2), Eigen::RowVector3d(0, 1, 0));
+  EXPECT_EQ(mesh.F.row(0), Eigen::RowVector3i(0, 1, 2));
+  EXPECT_EQ(report.warnings().size(), 4u);
+}
+
+TEST(Cleanup, ObjIndexForms) {
+  const std::string obj =
+      "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\nvn 0 0 1\n"
+      "f 1/1/1 2/1/1 3/1/1\n"
+      "f -3//1 -1//1 -2//1\n";  // = 2 4 3
+  const Mesh mesh = read_text(obj, MeshFormat::Obj);
+  ASSERT_EQ(mesh.num_faces(), 2);
+  EXPECT_EQ(mesh.F.row(1), Eigen::RowVector3i(1, 3, 2));
+}
+
+// Sum of the triangles' areas projected on the polygon's normal, and of their absolute areas:
+// equal exactly when no triangle is folded over.
+std::pair<double, double> signed_and_absolute_area(const Mesh& mesh, const Eigen::Vector3d& normal) {
+  double signed_area = 0, absolute = 0;
+  for (Index f = 0; f < mesh.num_faces(); ++f) {
+    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), b = mesh.V.row(mesh.F(f, 1)), c = mesh.V.row(mesh.F(f, 2));
+    const Eigen::Vector3d n = 0.5 * (b - a).cross(c - a);
+    signed_area += n.dot(normal);
+    absolute += n.norm();
+  }
+  return {signed_area, absolute};
+}
+
+TEST(Triangulation, NonConvexPolygonIsTriangulatedInside) {
+  // An L-shaped hexagon (area 3) in a tilted plane, and a non-convex "arrow" pentagon. A fan
+  // from the first corner folds triangles over for both.
+  const std::string off =
+      "OFF\n11 2 0\n"
+      "0 0 0\n2 0 0\n2 1 1\n1 1 1\n1 2 2\n0 2 2\n"   // L, plane y = z
+      "0 0 5\n4 0 5\n1 1 5\n4 4 5\n0 4 5\n"         // arrow, z = 5
+      "6 3 4 5 0 1 2\n"                                 // starts at the reflex corner's neighbour
+      "5 8 9 10 6 7\n";                                 // starts at the reflex corner
+  ReadReport report;
+  const Mesh mesh = read_text(off, MeshFormat::Off, &report);
+  EXPECT_EQ(report.polygons_triangulated, 2);
+  EXPECT_EQ(report.polygons_fanned, 0);
+  ASSERT_EQ(mesh.num_faces(), 4 + 3);
+  Mesh l_shape = mesh, arrow = mesh;
+  l_shape.F = mesh.F.topRows(4);
+  arrow.F = mesh.F.bottomRows(3);
+  const auto [l_signed, l_abs] = signed_and_absolute_area(l_shape, Eigen::Vector3d(0, -1, 1).normalized());
+  EXPECT_NEAR(l_signed, 3 * std::sqrt(2.0), 1e-12);
+  EXPECT_NEAR(l_abs, 3 * std::sqrt(2.0), 1e-12);
+  // Arrow area: square 16 minus the notch triangle (0,0)-(4,0)-(1,1) and (4,4)... computed by shoelace.
+  const double xs[] = {0, 4, 1, 4, 0}, ys[] = {0, 0, 1, 4, 4};
+  double shoelace = 0;
+  for (int i = 0; i < 5; ++i) shoelace += xs[i] * ys[(i + 1) % 5] - xs[(i + 1) % 5] * ys[i];
+  const auto [a_signed, a_abs] = signed_and_absolute_area(arrow, Eigen::Vector3d(0, 0, 1));
+  EXPECT_NEAR(a_signed, 0.5 * shoelace, 1e-12);
+  EXPECT_NEAR(a_abs, 0.5 * shoelace, 1e-12);
+}
+
+TEST(Triangulation, NonConvexQuadUsesTheValidDiagonal) {
+  // A dart: corner 2 is reflex, so only the diagonal 0-2 is valid.
+  const std::string off = "OFF\n4 1 0\n0 0 0\n4 0 0\n1 1 0\n0 4 0\n4 0 1 2 3\n";
+  const Mesh mesh = read_text(off, MeshFormat::Off);
+  ASSERT_EQ(mesh.num_faces(), 2);
+  const auto [signed_area, absolute] = signed_and_absolute_area(mesh, Eigen::Vector3d(0, 0, 1));
+  EXPECT_NEAR(signed_area, 4.0, 1e-12);
+  EXPECT_NEAR(absolute, 4.0, 1e-12);
+}
+
+TEST(Triangulation, SelfIntersectingPolygonIsFannedWithAWarning) {
+  // A bow-tie pentagon whose edges cross.
+  const std::string off = "OFF\n5 1 0\n0 0 0\n2 2 0\n2 0 0\n0 2 0\n1 3 0\n5 0 1 2 3 4\n";
+  ReadReport report;
+  const Mesh mesh = read_text(off, MeshFormat::Off, &report);
+  EXPECT_EQ(report.polygons_fanned, 1);
+  EXPECT_EQ(mesh.num_faces(), 3);
+}
+
+TEST(ReadPly, AsciiWithColoursAndProperties) {
+  const std::string ply =
+      "ply\nformat ascii 1.0\ncomment test\nelement vertex 3\nproperty float x\nproperty float y\n"
+      "property float z\nproperty uchar red\nproperty uchar green\nproperty uchar blue\nproperty double k1\n"
+      "element face 1\nproperty list uchar int vertex_indices\nproperty int flags\nend_header\n"
+      "0 0 0 255 0 0 0.5\n1 0 0 0 255 0 -1.5\n0 1 0 0 0 255 2\n3 0 1 2 7\n";
+  const Mesh mesh = read_text(ply, MeshFormat::Ply);
+  ASSERT_EQ(mesh.num_faces(), 1);
+  ASSERT_EQ(mesh.colors.rows(), 3);
+  EXPECT_EQ(mesh.colors(1, 1), 255);
+  const VertexProperty* k1 = mesh.find_vertex_property("k1");
+  ASSERT_NE(k1, nullptr);
+  EXPECT_EQ(k1->values[1], -1.5);
+}
+
+}  // namespace
+}  // namespace vertexflow

@@ -1,0 +1,84 @@
+// Writing is atomic and never clobbers the input by accident.
+#include "test_support.h"
+
+#include "vertexflow/io.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
+
+namespace vertexflow {
+namespace {
+
+Mesh triangle() {
+  Mesh mesh;
+  mesh.V.resize(3, 3);
+  mesh.V << 0, 0, 0, 1, 0, 0, 0, 1, 0;
+  mesh.F.resize(1, 3);
+  mesh.F << 0, 1, 2;
+  return mesh;
+}
+
+int count_entries(const std::filesystem::path& dir) {
+  int n = 0;
+  for ([[maybe_unused]] const auto& e : std::filesystem::directory_iterator(dir)) ++n;
+  return n;
+}
+
+TEST(WriteMesh, FailureLeavesExistingFileUntouchedAndNoTemporary) {
+  test::ScratchDir dir("atomic");
+  const auto path = dir.file("out.ply");
+  { std::ofstream(path) << "precious"; }
+  Mesh bad = triangle();
+  bad.vertex_properties.push_back({"broken", Eigen::VectorXd::Zero(2)});  // wrong size: fails mid-write
+  EXPECT_THROW(write_mesh(path, bad), IoError);
+  EXPECT_EQ(test::read_text(path), "precious");
+  EXPECT_EQ(count_entries(dir.path()), 1);
+}
+
+TEST(WriteMesh, InvalidFaceIndexIsRefusedBeforeWriting) {
+  test::ScratchDir dir("invalid");
+  Mesh bad = triangle();
+  bad.F(0, 2) = 7;
+  EXPECT_THROW(write_mesh(dir.file("out.obj"), bad), IoError);
+  EXPECT_EQ(count_entries(dir.path()), 0);
+}
+
+TEST(WriteMesh, ErrorsNameTheFile) {
+  test::ScratchDir dir("errors");
+  const auto missing_dir = dir.file("no/such/dir/out.off");
+  try {
+    write_mesh(missing_dir, triangle());
+    FAIL() << "expected IoError";
+  } catch (const IoError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(missing_dir.string(), 0), 0u) << e.what();
+  }
+  EXPECT_THROW(write_mesh(dir.file("out.xyz"), triangle()), IoError);
+  EXPECT_THROW(write_mesh(dir.path(), triangle()), IoError);
+}
+
+TEST(WriteMesh, ReplacesAnExistingFile) {
+  test::ScratchDir dir("replace");
+  const auto path = dir.file("out.obj");
+  { std::ofstream(path) << "old"; }
+  write_mesh(path, triangle());
+  EXPECT_EQ(read_mesh(path).num_faces(), 1);
+}
+
+TEST(CheckOutputPath, RefusesTheInputUnlessForced) {
+  test::ScratchDir dir("same");
+  const auto input = dir.file("in.obj");
+  write_mesh(input, triangle());
+  EXPECT_THROW(check_output_path(input, input, false), IoError);
+  // The same file under another spelling, and through a hard link.
+  EXPECT_THROW(check_output_path(input, dir.path() / "." / "in.obj", false), IoError);
+  std::filesystem::create_hard_link(input, dir.file("link.obj"));
+  EXPECT_THROW(check_output_path(input, dir.file("link.obj"), false), IoError);
+  EXPECT_NO_THROW(check_output_path(input, input, true));
+  EXPECT_NO_THROW(check_output_path(input, dir.file("out.ply"), false));
+  EXPECT_THROW(check_output_path(input, dir.path(), false), IoError);
+  EXPECT_THROW(check_output_path(input, dir.file("out.unknown"), false), IoError);
+}
+
+}  // namespace
+}  // namespace vertexflow

@@ -1,0 +1,55 @@
+// Shared helpers for the tests: paths to bundled data and scratch directories.
+#pragma once
+
+#include <filesystem>
+#include <string>
+
+namespace vertexflow::test {
+
+/// A mesh bundled in data/ (VERTEXFLOW_DATA_DIR is set by tests/CMakeLists.txt).
+inline std::filesystem::path data_path(const std::string& name) {
+  return std::filesystem::path(VERTEXFLOW_DATA_DIR) / name;
+}
+
+/// A file under tests/data/ (VERTEXFLOW_TEST_DATA_DIR).
+inline std::filesystem::path test_data_path(const std::string& name) {
+  return std::filesystem::path(VERTEXFLOW_TEST_DATA_DIR) / name;
+}
+
+/// A fresh empty directory for one test, removed when the object goes out of scope.
+class ScratchDir {
+ public:
+  explicit ScratchDir(const std::string& tag);
+  ScratchDir(const ScratchDir&) = delete;
+  ScratchDir& operator=(const ScratchDir&) = delete;
+  ~ScratchDir();
+  [[nodiscard]] const std::filesystem::path& path() const { return path_; }
+  [[nodiscard]] std::filesystem::path file(const std::string& name) const { return path_ / name; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+/// A string made of letters, digits and '_' only, for parameterised test names.
+std::string test_name(const std::string& s);
+
+/// Result of running a shell command.
+struct CommandResult {
+  int exit_code = -1;      ///< exit status, or -1 if the process died from a signal
+  std::string out;         ///< stdout
+  std::string err;         ///< stderr
+};
+
+/// Runs `command` through /bin/sh, capturing stdout and stderr separately.
+CommandResult run_command(const std::string& command);
+
+/// Runs the built `vertexflow` CLI with `arguments` (already shell-quoted as needed).
+CommandResult run_cli(const std::string& arguments);
+
+/// Single-quotes a string for /bin/sh.
+std::string shell_quote(const std::string& s);
+
+/// The whole content of a file (empty if it cannot be read).
+std::string read_text(const std::filesystem::path& path);
+
+}  // namespace vertexflow::test
