@@ -126,6 +126,11 @@ class PlyParser {
         if (element.name.empty() || count.empty() || count.front() == '-')
           header.error("malformed element line");
         element.count = static_cast<std::uint64_t>(header.to_int(count, "an element count"));
+        // A second 'vertex' element would be read over the first, leaving soup_.rgb and the
+        // scalar properties sized for the first one's count (heap overflow in soup_to_mesh).
+        if (element.name == "vertex" &&
+            std::any_of(elements_.begin(), elements_.end(), [](const Element& e) { return e.name == "vertex"; }))
+          header.error("more than one 'vertex' element");
         elements_.push_back(std::move(element));
       } else if (keyword == "property") {
         if (elements_.empty()) header.error("property before any element");
@@ -198,7 +203,7 @@ class PlyParser {
 
   // --- value access: ASCII tokens or binary bytes, advancing body_ ---
   double next_value(Type type, const char* what) {
-    if (encoding_ == Encoding::Ascii) return ascii().next_double(what);
+    if (encoding_ == Encoding::Ascii) return ascii_value(what);
     const std::size_t size = type_size(type);
     if (body_ + size > bytes_.size()) truncated(what);
     const double v = load_value(bytes_.data() + body_, type, swap_);
@@ -207,7 +212,7 @@ class PlyParser {
   }
   std::int64_t next_integer(Type type, const char* what) {
     if (encoding_ == Encoding::Ascii) {
-      const double v = ascii().next_double(what);
+      const double v = ascii_value(what);
       if (v != std::floor(v) || std::abs(v) > 9e15) ascii().error(fmt::format("expected an integer {}", what));
       return static_cast<std::int64_t>(v);
     }
@@ -237,6 +242,22 @@ class PlyParser {
     fail(name_, fmt::format("unexpected end of file while reading {} (file truncated?)", what));
   }
   // ASCII body scanning shares body_ through a scanner positioned at it.
+  // ASCII PLY has one element record per line: values are taken from the current line only,
+  // and begin_record/end_record check that a record neither spills over nor leaves values.
+  double ascii_value(const char* what) {
+    const std::string_view tok = ascii().token_on_line();
+    if (tok.empty()) ascii().error(fmt::format("too few values on the line (expected {})", what));
+    return ascii().to_double(tok, what);
+  }
+  void begin_record() {
+    if (encoding_ == Encoding::Ascii) ascii().skip_whitespace();
+  }
+  void end_record(const Element& element) {
+    if (encoding_ != Encoding::Ascii) return;
+    ascii().skip_blanks();
+    if (!ascii().at_end() && ascii().peek() != '\n')
+      ascii().error(fmt::format("more values than the '{}' element declares", element.name));
+  }
   TextScanner& ascii() {
     if (!scanner_) {
       scanner_.emplace(bytes_, name_);
@@ -279,6 +300,7 @@ class PlyParser {
       }
     }
     for (std::size_t v = 0; v < n; ++v) {
+      begin_record();
       for (std::size_t i = 0; i < element.properties.size(); ++i) {
         const Property& p = element.properties[i];
         switch (roles[i]) {
@@ -298,6 +320,7 @@ class PlyParser {
             break;
         }
       }
+      end_record(element);
     }
     sync_ascii();
   }
@@ -317,6 +340,7 @@ class PlyParser {
     soup_.offsets.reserve(n + 1);
     soup_.corners.reserve(3 * n);
     for (std::size_t f = 0; f < n; ++f) {
+      begin_record();
       for (std::size_t i = 0; i < element.properties.size(); ++i) {
         const Property& p = element.properties[i];
         if (i != index_property) {
@@ -332,6 +356,7 @@ class PlyParser {
         }
       }
       soup_.end_polygon();
+      end_record(element);
     }
     sync_ascii();
   }
@@ -340,7 +365,9 @@ class PlyParser {
     check_count(element);
     if (element.properties.empty()) return;
     for (std::uint64_t r = 0; r < element.count; ++r) {
+      begin_record();
       for (const Property& p : element.properties) skip_property(p);
+      end_record(element);
     }
     sync_ascii();
   }

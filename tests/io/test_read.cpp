@@ -250,5 +250,25 @@ TEST(ReadPly, AsciiWithColoursAndProperties) {
   EXPECT_EQ(k1->values[1], -1.5);
 }
 
+TEST(ReadPly, AsciiRecordsMustMatchTheHeaderLineByLine) {
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
+  EXPECT_NO_THROW(read_text(header + "0 0 0\n1 0 0\n\n0 1 0\n3 0 1 2\n", MeshFormat::Ply));
+  // A missing coordinate would otherwise silently shift every later value.
+  try {
+    read_text(header + "0 0\n1 0 0\n0 1 0\n3 0 1 2\n", MeshFormat::Ply);
+    FAIL();
+  } catch (const IoError& e) {
+    EXPECT_STREQ(e.what(), "memory: line 10: too few values on the line (expected a vertex coordinate)");
+  }
+  try {
+    read_text(header + "0 0 0\n1 0 0\n0 1 0\n4 0 1 2 1 5\n", MeshFormat::Ply);
+    FAIL();
+  } catch (const IoError& e) {
+    EXPECT_STREQ(e.what(), "memory: line 13: more values than the 'face' element declares");
+  }
+}
+
 }  // namespace
 }  // namespace vertexflow
