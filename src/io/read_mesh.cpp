@@ -87,7 +87,10 @@ namespace {
 
 std::string read_file_bytes(const std::filesystem::path& path) {
   const std::string name = path.string();
-  const int fd = ::open(name.c_str(), O_RDONLY | O_CLOEXEC);
+  // O_NONBLOCK: opening a FIFO (e.g. "pipe.obj") for reading would otherwise block until a
+  // writer appears; this way it opens at once and is refused below as not a regular file.
+  // It has no effect on reads from regular files.
+  const int fd = ::open(name.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
   if (fd < 0) fail(name, std::string("cannot open: ") + std::strerror(errno));
   struct stat st {};
   if (::fstat(fd, &st) != 0) {
