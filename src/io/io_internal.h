@@ -181,6 +181,11 @@ class TextScanner {
     if (tok.empty() || ptr != tok.data() + tok.size() ||
         (ec != std::errc() && ec != std::errc::result_out_of_range))
       error(std::string("expected ") + what + ", found '" + printable(tok) + "'");
+    // from_chars leaves `value` unchanged (0) when the number does not fit a double, so
+    // "1e999" used to read as 0. Such a number (overflow, or underflow below the smallest
+    // subnormal, which no writer produces) is an error.
+    if (ec == std::errc::result_out_of_range)
+      error(std::string("number '") + printable(tok) + "' is out of range (reading " + what + ")");
     return value;
   }
   std::int64_t to_int(std::string_view tok, const char* what) const {
