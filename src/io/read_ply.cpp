@@ -309,6 +309,10 @@ class PlyParser {
             break;
           case Role::Red: case Role::Green: case Role::Blue: {
             const double c = next_value(p.type, "a vertex colour");
+            // Declared uchar, but ASCII text can hold any number, and converting a double
+            // outside 0..255 (or NaN) to uint8 is undefined behaviour. (Found by fuzz_read_ply.)
+            if (encoding_ == Encoding::Ascii && !(c >= 0 && c <= 255))
+              ascii().error(fmt::format("vertex colour {} is outside 0..255", c));
             if (!soup_.rgb.empty()) soup_.rgb[3 * v + static_cast<std::size_t>(roles[i]) - 3] = static_cast<std::uint8_t>(c);
             break;
           }
