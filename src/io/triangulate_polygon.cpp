@@ -98,8 +98,13 @@ bool triangulate_general(const double* xyz, const Index* c, std::size_t n, const
     handles[i]->info() = c[i];
   }
   if (cdt.number_of_vertices() != n) return false;  // coincident corners in the plane
-  for (std::size_t i = 0; i < n; ++i) cdt.insert_constraint(handles[i], handles[(i + 1) % n]);
-  if (cdt.number_of_vertices() != n) return false;  // constraints crossed: self-intersecting
+  for (std::size_t i = 0; i < n; ++i) {
+    cdt.insert_constraint(handles[i], handles[(i + 1) % n]);
+    // Constraints crossed (a vertex was added at the crossing): self-intersecting. Checked
+    // after every edge, not once at the end, because the n edges of a star polygon cross
+    // each other O(n^2) times (a 135 kB OBJ with one 4000-corner star face took 11 s, 1.3 GB).
+    if (cdt.number_of_vertices() != n) return false;
+  }
 
   // Flood from the infinite face; crossing a constrained edge increments the count.
   std::deque<Cdt::Face_handle> queue{cdt.infinite_face()};
