@@ -49,12 +49,13 @@ for f in "${formats[@]}"; do
   seed "$f" "$corpus"
   before=$(ls "$artifacts" | wc -l)
   echo "== fuzz_read_$f for ${seconds}s (corpus $corpus)"
-  # -timeout: an input taking over 10 s is a hang; -rss_limit_mb: the reader's allocations must
-  # stay bounded by the input size (max_len 64 kB), so 2 GB means a header was trusted.
+  # -timeout: an input taking over 10 s is a hang. -malloc_limit_mb / -rss_limit_mb: the
+  # reader's allocations must stay bounded by the input size (at most 64 kB, or 16 MB inflated;
+  # see fuzz_read.h), so one 512 MB allocation or 2 GB in all means a header count was trusted.
   rc=0
   "$build/bin/fuzz_read_$f" "$corpus" -dict="$root/tests/fuzz/$f.dict" \
     -artifact_prefix="$artifacts/" -max_total_time="$seconds" -max_len=65536 \
-    -timeout=10 -rss_limit_mb=2048 -print_final_stats=1 >"$build/fuzz_read_$f.log" 2>&1 || rc=$?
+    -timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=512 -print_final_stats=1 >"$build/fuzz_read_$f.log" 2>&1 || rc=$?
   grep -E '^(#[0-9]+ +(INITED|DONE)|==[0-9]+==ERROR|SUMMARY|stat::(number_of_executed_units|average_exec_per_sec|peak_rss_mb)|Test unit written)' \
     "$build/fuzz_read_$f.log" || true
   if [ "$rc" -ne 0 ] || [ "$(ls "$artifacts" | wc -l)" -ne "$before" ]; then
