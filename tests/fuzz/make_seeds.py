@@ -166,6 +166,11 @@ def main():
     write("cube_binary.stl", stl_binary(CUBE_V, CUBE_F))
     write("cube_binary_solid.stl", stl_binary(CUBE_V, CUBE_F, comment=b"solid but binary"))
     write("tet_ascii.stl.gz", gz(stl_ascii(TET_V, TET_F)))
+    # Extreme but finite coordinates: the polygon normal and projection overflow or underflow.
+    scaled = lambda s: [(x * s, y * s, z * s) for x, y, z in L_V]
+    write("lshape_huge.obj", obj(scaled(1e300), L_F))
+    write("lshape_tiny.obj", obj(scaled(1e-300), L_F))
+    write("cube_huge.off", off_ascii([(x * 1e200, y * 1e200, z * 1e200) for x, y, z in CUBE_V], CUBE_F))
 
 
 if __name__ == "__main__":
