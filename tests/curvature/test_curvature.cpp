@@ -1,0 +1,282 @@
+// Principal curvatures against analytic surfaces (sphere, cylinder, torus, saddle), under
+// refinement, rigid motion, scaling and orientation reversal, and on every bundled mesh.
+#include "shapes.h"
+#include "test_support.h"
+
+#include "vertexflow/curvature.h"
+#include "vertexflow/io.h"
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace vertexflow {
+namespace {
+
+double percentile(std::vector<double> values, double p) {
+  if (values.empty()) return 0;
+  const auto rank = static_cast<std::size_t>(std::ceil(p / 100.0 * static_cast<double>(values.size()))) - 1;
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(rank), values.end());
+  return values[rank];
+}
+
+// Angle in degrees between two directions, ignoring sign (principal directions are lines).
+double line_angle_degrees(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::acos(std::min(1.0, std::abs(a.normalized().dot(b.normalized())))) * 180.0 / M_PI;
+}
+
+struct TorusErrors {
+  double k1_median, k1_p95, k2_median, k2_p95, direction_median;
+};
+
+// Errors on a torus (R, r): k1 = 1/r along the tube, k2 = cos(theta) / (R + r cos(theta))
+// along the big circle. Relative errors of k2 are taken where |k2| is at least a tenth of its
+// maximum (near theta = +-90 degrees k2 crosses zero and a relative error is meaningless).
+TorusErrors torus_errors(double R, double r, int around, int tube) {
+  const Mesh mesh = test::torus(R, r, around, tube);
+  const Curvature c = principal_curvatures(mesh.V, mesh.F);
+  std::vector<double> e1, e2, angles;
+  const double k2_max = 1.0 / (R + r);
+  for (Index v = 0; v < mesh.num_vertices(); ++v) {
+    const Eigen::Vector3d p = mesh.V.row(v).transpose();
+    const double rho = std::hypot(p.x(), p.y());
+    const double cos_theta = (rho - R) / r;
+    const double k1 = 1.0 / r, k2 = cos_theta / (R + r * cos_theta);
+    e1.push_back(std::abs(c.k1[v] - k1) / k1);
+    if (std::abs(k2) >= 0.1 * k2_max) e2.push_back(std::abs(c.k2[v] - k2) / std::abs(k2));
+    // T2 (the smaller curvature) runs along the big circle: the azimuthal direction.
+    const Eigen::Vector3d azimuthal(-p.y() / rho, p.x() / rho, 0);
+    angles.push_back(line_angle_degrees(c.T2.row(v).transpose(), azimuthal));
+  }
+  return {percentile(e1, 50), percentile(e1, 95), percentile(e2, 50), percentile(e2, 95), percentile(angles, 50)};
+}
+
+TEST(Curvature, TorusMatchesAnalyticValues) {
+  // 400 x 100 = 40,000 vertices; R = 3, r = 1 keeps the triangles well shaped.
+  const TorusErrors e = torus_errors(3.0, 1.0, 400, 100);
+  EXPECT_LE(e.k1_median, 0.01);
+  EXPECT_LE(e.k1_p95, 0.05);
+  EXPECT_LE(e.k2_median, 0.01);
+  EXPECT_LE(e.k2_p95, 0.05);
+  EXPECT_LE(e.direction_median, 5.0);
+  std::printf("torus 40k: k1 median %.4f%% p95 %.4f%%, k2 median %.4f%% p95 %.4f%%, direction median %.3f deg\n",
+              100 * e.k1_median, 100 * e.k1_p95, 100 * e.k2_median, 100 * e.k2_p95, e.direction_median);
+}
+
+TEST(Curvature, ErrorDecreasesUnderRefinement) {
+  const TorusErrors coarse = torus_errors(3.0, 1.0, 100, 25);
+  const TorusErrors medium = torus_errors(3.0, 1.0, 200, 50);
+  const TorusErrors fine = torus_errors(3.0, 1.0, 400, 100);
+  EXPECT_LT(medium.k1_median, coarse.k1_median);
+  EXPECT_LT(fine.k1_median, medium.k1_median);
+  EXPECT_LT(medium.k2_median, coarse.k2_median);
+  EXPECT_LT(fine.k2_median, medium.k2_median);
+}
+
+TEST(Curvature, SphereIsUmbilicWithCurvatureOneOverR) {
+  for (const double R : {0.5, 1.0, 20.0}) {
+    const Mesh mesh = test::icosphere(R, 5);
+    const Curvature c = principal_curvatures(mesh.V, mesh.F);
+    std::vector<double> e1, e2;
+    for (Index v = 0; v < mesh.num_vertices(); ++v) {
+      e1.push_back(std::abs(c.k1[v] * R - 1));
+      e2.push_back(std::abs(c.k2[v] * R - 1));
+      // Outward normals.
+      ASSERT_GT(c.N.row(v).dot(mesh.V.row(v)), 0);
+    }
+    EXPECT_LE(percentile(e1, 50), 0.01) << "R = " << R;
+    EXPECT_LE(percentile(e2, 50), 0.01) << "R = " << R;
+  }
+}
+
+TEST(Curvature, IrregularUnitSphere) {
+  // sphere.off: an irregular (remeshed, not subdivided) triangulation of the unit sphere.
+  const Mesh mesh = read_mesh(test::data_path("sphere.off"));
+  const Curvature c = principal_curvatures(mesh.V, mesh.F);
+  std::vector<double> e1, e2;
+  for (Index v = 0; v < mesh.num_vertices(); ++v) {
+    const double R = mesh.V.row(v).norm();
+    e1.push_back(std::abs(c.k1[v] * R - 1));
+    e2.push_back(std::abs(c.k2[v] * R - 1));
+  }
+  EXPECT_LE(percentile(e1, 50), 0.01);
+  EXPECT_LE(percentile(e2, 50), 0.01);
+  EXPECT_LE(percentile(e1, 95), 0.05);
+  EXPECT_LE(percentile(e2, 95), 0.05);
+}
+
+TEST(Curvature, CylinderOneOverRAndZero) {
+  // Catches the biased reference 3x3 LDLT (k1 = 0.93 on R = 1).
+  const double R = 1.0;
+  const Mesh mesh = test::cylinder(R, 4.0, 120, 80);
+  const Topology topology = build_topology(mesh.F, mesh.num_vertices());
+  const Curvature c = principal_curvatures(mesh.V, mesh.F, topology);
+  std::vector<double> e1, e2, angles;
+  for (Index v = 0; v < mesh.num_vertices(); ++v) {
+    if (topology.is_boundary_vertex[static_cast<std::size_t>(v)]) continue;
+    e1.push_back(std::abs(c.k1[v] - 1 / R) * R);
+    e2.push_back(std::abs(c.k2[v]) * R);
+    const Eigen::Vector3d p = mesh.V.row(v).transpose();
+    angles.push_back(line_angle_degrees(c.T1.row(v).transpose(), Eigen::Vector3d(-p.y(), p.x(), 0)));
+  }
+  EXPECT_LE(percentile(e1, 50), 0.01);
+  EXPECT_LE(percentile(e1, 95), 0.05);
+  EXPECT_LE(percentile(e2, 50), 0.01);
+  EXPECT_LE(percentile(angles, 50), 1.0);
+}
+
+TEST(Curvature, SaddleAtTheOrigin) {
+  const Mesh mesh = test::saddle(0.5, 40);  // vertex (20, 20) is the origin
+  const Curvature c = principal_curvatures(mesh.V, mesh.F);
+  const Index origin = 20 * 41 + 20;
+  ASSERT_EQ(mesh.V.row(origin).norm(), 0.0);
+  // Normals up: the surface bends away from the normal along y (k = +1), towards it along x.
+  EXPECT_NEAR(c.k1[origin], 1.0, 0.01);
+  EXPECT_NEAR(c.k2[origin], -1.0, 0.01);
+  EXPECT_LE(line_angle_degrees(c.T1.row(origin).transpose(), Eigen::Vector3d::UnitY()), 2.0);
+  EXPECT_NEAR(c.gaussian()[origin], -1.0, 0.02);
+  EXPECT_NEAR(c.mean()[origin], 0.0, 0.01);
+}
+
+TEST(Curvature, FramesAreOrthonormalAndRightHanded) {
+  const Mesh mesh = read_mesh(test::data_path("fandisk.off"));
+  const Curvature c = principal_curvatures(mesh.V, mesh.F);
+  for (Index v = 0; v < mesh.num_vertices(); ++v) {
+    const Eigen::Vector3d t1 = c.T1.row(v).transpose(), t2 = c.T2.row(v).transpose(), n = c.N.row(v).transpose();
+    ASSERT_NEAR(t1.norm(), 1.0, 1e-12);
+    ASSERT_NEAR(t2.norm(), 1.0, 1e-12);
+    ASSERT_NEAR(t1.dot(n), 0.0, 1e-12);
+    ASSERT_LE((t1.cross(t2) - n).norm(), 1e-12);
+    ASSERT_GE(c.k1[v], c.k2[v]);
+  }
+}
+
+TEST(Curvature, RigidMotionAndScaling) {
+  const Mesh mesh = read_mesh(test::data_path("spot.obj"));
+  const Curvature c = principal_curvatures(mesh.V, mesh.F);
+  const double s = 7.25;
+  const Eigen::Matrix3d rotation =
+      Eigen::AngleAxisd(1.1, Eigen::Vector3d(0.3, -0.5, 0.8).normalized()).toRotationMatrix();
+  const Eigen::RowVector3d translation(10, -3, 2.5);
+  Mesh moved = mesh;
+  moved.V = (s * (mesh.V * rotation.transpose())).rowwise() + translation;
+  const Curvature m = principal_curvatures(moved.V, moved.F);
+  const double scale = c.k1.cwiseAbs().maxCoeff();
+  for (Index v = 0; v < mesh.num_vertices(); ++v) {
+    ASSERT_NEAR(m.k1[v] * s, c.k1[v], 1e-9 * scale) << v;
+    ASSERT_NEAR(m.k2[v] * s, c.k2[v], 1e-9 * scale) << v;
+    ASSERT_LE((m.N.row(v).transpose() - rotation * c.N.row(v).transpose()).norm(), 1e-9);
+    // Directions are defined where the curvatures differ.
+    if (c.k1[v] - c.k2[v] > 1e-3 * scale) {
+      ASSERT_LE(line_angle_degrees(m.T1.row(v).transpose(), rotation * c.T1.row(v).transpose()), 1e-5) << v;
+    }
+  }
+}
+
+TEST(Curvature, ReversedOrientationFlipsTheSign) {
+  const Mesh mesh = read_mesh(test::data_path("bunny_uniform.off"));
+  Mesh reversed = mesh;
+  reversed.F.col(1).swap(reversed.F.col(2));
+  const Curvature c = principal_curvatures(mesh.V, mesh.F);
+  const Curvature r = principal_curvatures(reversed.V, reversed.F);
+  const double scale = c.k1.cwiseAbs().maxCoeff();
+  for (Index v = 0; v < mesh.num_vertices(); ++v) {
+    ASSERT_NEAR(r.k1[v], -c.k2[v], 1e-9 * scale);
+    ASSERT_NEAR(r.k2[v], -c.k1[v], 1e-9 * scale);
+    ASSERT_LE((r.N.row(v) + c.N.row(v)).norm(), 1e-12);
+  }
+}
+
+TEST(Curvature, SameResultForOneAndTwoThreads) {
+  const Mesh mesh = read_mesh(test::data_path("armadillo-43k.obj"));
+  Curvature one, two;
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+    one = principal_curvatures(mesh.V, mesh.F, CurvatureOptions{NormalWeighting::Max1999, 1});
+  }
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+    two = principal_curvatures(mesh.V, mesh.F, CurvatureOptions{NormalWeighting::Max1999, 1});
+  }
+  EXPECT_EQ(one.k1, two.k1);
+  EXPECT_EQ(one.k2, two.k2);
+  EXPECT_EQ(one.T1, two.T1);
+  EXPECT_EQ(one.N, two.N);
+}
+
+TEST(Curvature, HemisphereBoundaryIsFiniteAndItsBiasIsBounded) {
+  // hemisphere.off is half of a unit sphere: interior k = 1; the boundary ring sees only one
+  // side of its neighbourhood.
+  const Mesh mesh = read_mesh(test::data_path("hemisphere.off"));
+  const Topology topology = build_topology(mesh.F, mesh.num_vertices());
+  const Curvature c = principal_curvatures(mesh.V, mesh.F, topology);
+  const double R = mesh.V.rowwise().norm().mean();
+  std::vector<double> interior, boundary;
+  for (Index v = 0; v < mesh.num_vertices(); ++v) {
+    ASSERT_TRUE(std::isfinite(c.k1[v]) && std::isfinite(c.k2[v]));
+    const double mean_error = std::abs(c.mean()[v] * R - 1);
+    (topology.is_boundary_vertex[static_cast<std::size_t>(v)] ? boundary : interior).push_back(mean_error);
+  }
+  EXPECT_LE(percentile(interior, 50), 0.01);
+  // Documented in curvature.h: the boundary is biased but bounded.
+  EXPECT_LE(percentile(boundary, 50), 0.25);
+  std::printf("hemisphere: interior median |H R - 1| %.4f, boundary median %.4f\n", percentile(interior, 50),
+              percentile(boundary, 50));
+}
+
+TEST(Curvature, AreasSumToSurfaceArea) {
+  const Mesh mesh = read_mesh(test::data_path("camelhead.off"));  // has obtuse triangles
+  const Eigen::VectorXd areas = vertex_areas(mesh.V, mesh.F);
+  double total = 0;
+  for (Index f = 0; f < mesh.num_faces(); ++f) total += face_area(mesh.V, mesh.F, f);
+  EXPECT_NEAR(areas.sum(), total, 1e-12 * total);
+  EXPECT_GE(areas.minCoeff(), 0.0);
+}
+
+TEST(Curvature, NormalsOfASphereAreRadial) {
+  const Mesh mesh = test::icosphere(2.0, 3);
+  for (const auto weighting : {NormalWeighting::Max1999, NormalWeighting::Area, NormalWeighting::Angle}) {
+    const Vertices N = vertex_normals(mesh.V, mesh.F, weighting);
+    double worst = 0;
+    for (Index v = 0; v < mesh.num_vertices(); ++v) worst = std::max(worst, (N.row(v) - mesh.V.row(v) / 2.0).norm());
+    // Max's weighting is exact for vertices on a sphere; the others are close.
+    EXPECT_LE(worst, weighting == NormalWeighting::Max1999 ? 1e-12 : 2e-2);
+  }
+}
+
+TEST(Curvature, DegenerateInputStaysFinite) {
+  Mesh mesh;
+  mesh.V.resize(5, 3);
+  mesh.V << 0, 0, 0, 1, 0, 0, 2, 0, 0, 0, 1, 0, 5, 5, 5;  // a collinear face and an isolated vertex
+  mesh.F.resize(2, 3);
+  mesh.F << 0, 1, 2, 0, 1, 3;
+  const Curvature c = principal_curvatures(mesh.V, mesh.F);
+  EXPECT_TRUE(c.k1.allFinite() && c.k2.allFinite() && c.T1.allFinite() && c.T2.allFinite() && c.N.allFinite());
+  EXPECT_EQ(c.k1[4], 0.0);
+}
+
+class BundledCurvature : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(BundledCurvature, NoNanOrInf) {
+  const Mesh mesh = read_mesh(test::data_path(GetParam()));
+  const Curvature c = principal_curvatures(mesh.V, mesh.F);
+  EXPECT_TRUE(c.k1.allFinite());
+  EXPECT_TRUE(c.k2.allFinite());
+  EXPECT_TRUE(c.T1.allFinite());
+  EXPECT_TRUE(c.T2.allFinite());
+  EXPECT_TRUE(c.N.allFinite());
+}
+
+INSTANTIATE_TEST_SUITE_P(Data, BundledCurvature,
+                         ::testing::Values("bunny.off", "bunny_uniform.off", "bunny_adaptive.off", "amo.off",
+                                           "amo_adaptive.off", "fandisk.off", "fandisk_quads.off", "chamfer-cube.off",
+                                           "hemisphere.off", "sphere.off", "sphere_low.off", "icosahedron_ascii.stl",
+                                           "suzanne.obj", "max-planck-5k.obj", "armadillo-43k.obj", "camelhead.off",
+                                           "fertility.off", "torus.obj", "horse-48k.ply", "rocker-arm.obj", "spot.obj"),
+                         [](const auto& param_info) { return test::test_name(param_info.param); });
+
+}  // namespace
+}  // namespace vertexflow

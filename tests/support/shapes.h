@@ -1,0 +1,25 @@
+// Analytic test surfaces, triangulated: sphere, cylinder, torus and a saddle patch, with their
+// exact curvatures known in closed form.
+#pragma once
+
+#include "vertexflow/mesh.h"
+
+namespace vertexflow::test {
+
+/// Icosahedron subdivided `levels` times (each triangle into 4), projected onto the sphere of
+/// radius R centred at the origin; outward orientation. 10 * 4^levels + 2 vertices.
+Mesh icosphere(double radius, int levels);
+
+/// Open cylinder of radius R around the z axis, z in [0, height], `around` x `along` quads
+/// split into triangles (alternating diagonals); outward orientation.
+Mesh cylinder(double radius, double height, int around, int along);
+
+/// Torus around the z axis: tube centre radius R, tube radius r; `around` segments along the
+/// big circle, `tube` around the tube; vertex (i, j) is at angles (2 pi i / around,
+/// 2 pi j / tube) with theta = 0 on the outer equator; outward orientation.
+Mesh torus(double R, double r, int around, int tube);
+
+/// The saddle z = (x^2 - y^2) / 2 over [-half, half]^2, n x n quads; normals up (+z).
+Mesh saddle(double half, int n);
+
+}  // namespace vertexflow::test
