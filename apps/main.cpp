@@ -16,6 +16,7 @@ int main(int argc, char** argv) {
   app.add_flag("-q,--quiet", global.quiet, "Print no warnings or progress")->configurable(false);
   app.fallthrough();
   register_info_command(app, global);
+  register_curvature_command(app, global);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

@@ -1,8 +1,12 @@
 // The `vertexflow` executable end to end: output, JSON, exit codes, one-line errors.
 #include "test_support.h"
 
+#include "vertexflow/io.h"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+
+#include <fstream>
 
 namespace vertexflow {
 namespace {
@@ -10,6 +14,7 @@ namespace {
 using test::run_cli;
 using test::shell_quote;
 
+// Shell-quoted path of a bundled mesh.
 std::string data(const std::string& name) { return shell_quote(test::data_path(name).string()); }
 
 TEST(CliInfo, PrintsTheSummary) {
@@ -66,6 +71,54 @@ TEST(Cli, UsageErrorsFail) {
   const auto version = run_cli("--version");
   EXPECT_EQ(version.exit_code, 0);
   EXPECT_NE(version.out.find("vertexflow"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace vertexflow
+
+namespace vertexflow {
+namespace {
+
+TEST(CliCurvature, WritesPropertiesAndColours) {
+  test::ScratchDir dir("cli-curvature");
+  const auto out = dir.file("torus.ply");
+  const auto r = test::run_cli("curvature " + data("torus.obj") + " " + test::shell_quote(out.string()) +
+                               " --color mean --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  // torus.obj: R = 1, r = 0.25, so k1 = 1/r = 4 on every vertex.
+  EXPECT_NEAR(j["k1"]["median"].get<double>(), 4.0, 0.04);
+  EXPECT_LT(j["color"]["min"].get<double>(), 0.0);
+  const Mesh mesh = read_mesh(out);
+  for (const char* name : {"k1", "k2", "H", "K", "T1x", "T1y", "T1z", "T2x", "T2y", "T2z"})
+    EXPECT_NE(mesh.find_vertex_property(name), nullptr) << name;
+  EXPECT_EQ(mesh.colors.rows(), mesh.num_vertices());
+  // Positive mean curvature is red, on the outer equator of the torus.
+  const Eigen::VectorXd& H = mesh.find_vertex_property("H")->values;
+  Index most_positive = 0;
+  H.maxCoeff(&most_positive);
+  EXPECT_GT(mesh.colors(most_positive, 0), mesh.colors(most_positive, 2));
+}
+
+TEST(CliCurvature, RefusesToOverwriteTheInputAndNonManifoldMeshes) {
+  test::ScratchDir dir("cli-curvature-refuse");
+  const auto copy = dir.file("in.ply");
+  std::filesystem::copy_file(test::data_path("horse-48k.ply"), copy);
+  const std::string before = test::read_text(copy);
+  const auto r = test::run_cli("curvature " + test::shell_quote(copy.string()) + " " + test::shell_quote(copy.string()));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("refusing to overwrite"), std::string::npos) << r.err;
+  EXPECT_EQ(test::read_text(copy), before);
+
+  const auto nm = test::run_cli("curvature " + data("suzanne.obj") + " " + test::shell_quote(dir.file("s.ply").string()));
+  EXPECT_EQ(nm.exit_code, 0) << nm.err;  // suzanne triangulates to a manifold mesh
+  const auto bad = dir.file("bowtie.obj");
+  { std::ofstream(bad) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv -1 0 0\nv 0 -1 0\nf 1 2 3\nf 1 4 5\n"; }
+  const auto refused = test::run_cli("curvature " + test::shell_quote(bad.string()) + " " +
+                                     test::shell_quote(dir.file("b.ply").string()));
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_NE(refused.err.find("not manifold"), std::string::npos) << refused.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("b.ply")));
 }
 
 }  // namespace

@@ -1,0 +1,33 @@
+#include "vertexflow/colormap.h"
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+namespace vertexflow {
+
+double robust_color_limit(const Eigen::VectorXd& values) {
+  if (values.size() == 0) return 1.0;
+  std::vector<double> sorted(values.data(), values.data() + values.size());
+  std::sort(sorted.begin(), sorted.end());
+  auto at = [&](double p) {
+    const auto rank = static_cast<std::size_t>(std::ceil(p * static_cast<double>(sorted.size()))) - 1;
+    return sorted[std::min(rank, sorted.size() - 1)];
+  };
+  double limit = std::max(std::abs(at(0.05)), std::abs(at(0.95)));
+  if (!(limit > 0)) limit = std::max(std::abs(sorted.front()), std::abs(sorted.back()));
+  return limit > 0 && std::isfinite(limit) ? limit : 1.0;
+}
+
+Colors diverging_colors(const Eigen::VectorXd& values, double limit) {
+  const Eigen::Vector3d blue(59, 76, 192), white(221, 221, 221), red(180, 4, 38);
+  Colors colors(values.size(), 3);
+  for (Eigen::Index i = 0; i < values.size(); ++i) {
+    const double t = std::isfinite(values[i]) ? std::clamp(values[i] / limit, -1.0, 1.0) : 0.0;
+    const Eigen::Vector3d c = t >= 0 ? Eigen::Vector3d(white + t * (red - white)) : Eigen::Vector3d(white - t * (blue - white));
+    for (int k = 0; k < 3; ++k) colors(i, k) = static_cast<std::uint8_t>(std::lround(c[k]));
+  }
+  return colors;
+}
+
+}  // namespace vertexflow
