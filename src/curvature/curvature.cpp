@@ -24,32 +24,27 @@ void parallel_range(Index n, Body&& body) {
 
 Eigen::Vector3d position(const Vertices& V, Index v) { return V.row(v).transpose(); }
 
-// Contribution of corner k of face f to its vertex's normal.
-Eigen::Vector3d corner_normal(const Vertices& V, const Faces& F, Index f, int k, NormalWeighting weighting) {
-  const Eigen::Vector3d p = position(V, F(f, k));
-  const Eigen::Vector3d a = position(V, F(f, (k + 1) % 3)) - p;
-  const Eigen::Vector3d b = position(V, F(f, (k + 2) % 3)) - p;
-  const Eigen::Vector3d n = a.cross(b);
-  switch (weighting) {
-    case NormalWeighting::Max1999: {
-      const double scale = a.squaredNorm() * b.squaredNorm();
-      return scale > 0 ? Eigen::Vector3d(n / scale) : Eigen::Vector3d::Zero();
-    }
-    case NormalWeighting::Area:
-      return n;
-    case NormalWeighting::Angle: {
-      const double length = n.norm();
-      if (!(length > 0)) return Eigen::Vector3d::Zero();
-      return std::atan2(length, a.dot(b)) * n / length;
+// Weight of each corner's face normal in its vertex normal: the face normal n = (p1 - p0) x
+// (p2 - p0) is the cross product of the two edges at every corner, so a corner contributes
+// weight * n.
+Eigen::Vector3d corner_normal_weights(const Eigen::Vector3d p[3], const Eigen::Vector3d& n, NormalWeighting weighting) {
+  Eigen::Vector3d w = Eigen::Vector3d::Zero();
+  const double length = n.norm();
+  if (!(length > 0)) return w;
+  for (int k = 0; k < 3; ++k) {
+    const Eigen::Vector3d a = p[(k + 1) % 3] - p[k], b = p[(k + 2) % 3] - p[k];
+    switch (weighting) {
+      case NormalWeighting::Max1999: w[k] = 1.0 / (a.squaredNorm() * b.squaredNorm()); break;
+      case NormalWeighting::Area: w[k] = 1.0; break;
+      case NormalWeighting::Angle: w[k] = std::atan2(length, a.dot(b)) / length; break;
     }
   }
-  return n;
+  return w;
 }
 
 // Meyer et al. (2003) mixed areas of the three corners of one face.
-Eigen::Vector3d face_corner_areas(const Vertices& V, const Faces& F, Index f) {
-  const Eigen::Vector3d p[3] = {position(V, F(f, 0)), position(V, F(f, 1)), position(V, F(f, 2))};
-  const double area = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
+Eigen::Vector3d face_corner_areas(const Eigen::Vector3d p[3], const Eigen::Vector3d& n) {
+  const double area = 0.5 * n.norm();
   Eigen::Vector3d result = Eigen::Vector3d::Zero();
   if (!(area > 0)) return result;
   double dot[3];  // dot products of the two edges at each corner (negative = obtuse)
@@ -70,13 +65,29 @@ Eigen::Vector3d face_corner_areas(const Vertices& V, const Faces& F, Index f) {
   return result;
 }
 
-// The second fundamental form of one face, [[e, f], [f, g]] in the face's frame (t, b), with
-// face normal n = t x b.
+// Per-face quantities computed once: the (unnormalised) face normal, each corner's weight in
+// its vertex normal, and each corner's mixed area.
+struct FaceGeometry {
+  Eigen::Vector3d normal;
+  Eigen::Vector3d normal_weight;
+  Eigen::Vector3d corner_area;
+};
+
+FaceGeometry face_geometry(const Vertices& V, const Faces& F, Index f, NormalWeighting weighting) {
+  const Eigen::Vector3d p[3] = {position(V, F(f, 0)), position(V, F(f, 1)), position(V, F(f, 2))};
+  FaceGeometry g;
+  g.normal = (p[1] - p[0]).cross(p[2] - p[0]);
+  g.normal_weight = corner_normal_weights(p, g.normal, weighting);
+  g.corner_area = face_corner_areas(p, g.normal);
+  return g;
+}
+
+// The second fundamental form of one face, [[e, f], [f, g]] in the face's frame (t, n x t),
+// with n the unit face normal. A zero normal marks a degenerate face.
 struct FaceTensor {
   Eigen::Vector3d t = Eigen::Vector3d::Zero();
-  Eigen::Vector3d b = Eigen::Vector3d::Zero();
+  Eigen::Vector3d n = Eigen::Vector3d::Zero();
   double e = 0, f = 0, g = 0;
-  bool valid = false;
 };
 
 // Least-squares fit (Rusinkiewicz 2004, section 3): for each edge E (from corner j to corner
@@ -88,29 +99,41 @@ FaceTensor fit_face_tensor(const Vertices& V, const Faces& F, const Vertices& N,
   const double edge = (p[2] - p[1]).norm();
   if (!(normal.norm() > 0) || !(edge > 0)) return ft;
   ft.t = (p[2] - p[1]) / edge;
-  ft.b = normal.normalized().cross(ft.t);
-  Eigen::Matrix<double, 6, 3> A = Eigen::Matrix<double, 6, 3>::Zero();
-  Eigen::Matrix<double, 6, 1> rhs;
+  const Eigen::Vector3d unit_normal = normal.normalized();
+  const Eigen::Vector3d b = unit_normal.cross(ft.t);
+  // Normal equations of the rows (u, v, 0) . (e, f, g) = dN.t and (0, u, v) . (e, f, g) = dN.b,
+  // accumulated directly rather than through a 6 x 3 matrix.
+  double uu = 0, uv = 0, vv = 0;
+  Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
   for (int k = 0; k < 3; ++k) {
     const int j = (k + 1) % 3, l = (k + 2) % 3;
     const Eigen::Vector3d E = p[l] - p[j];
     const Eigen::Vector3d dN = N.row(F(face, l)).transpose() - N.row(F(face, j)).transpose();
-    const double u = E.dot(ft.t), v = E.dot(ft.b);
-    A.row(2 * k) << u, v, 0;
-    A.row(2 * k + 1) << 0, u, v;
-    rhs[2 * k] = dN.dot(ft.t);
-    rhs[2 * k + 1] = dN.dot(ft.b);
+    const double u = E.dot(ft.t), v = E.dot(b);
+    const double dnu = dN.dot(ft.t), dnv = dN.dot(b);
+    uu += u * u;
+    uv += u * v;
+    vv += v * v;
+    rhs += Eigen::Vector3d(u * dnu, v * dnu + u * dnv, v * dnv);
   }
-  // A robust small solve: the normal matrix is positive definite for any non-degenerate
-  // triangle, and Eigen's pivoted LDLT handles the ill-conditioned ones (needles) without
-  // reading unwritten entries, the flaw of the widely copied hand-written 3x3 LDLT.
-  const Eigen::Matrix3d normal_matrix = A.transpose() * A;
-  const Eigen::Vector3d solution = normal_matrix.ldlt().solve(A.transpose() * rhs);
+  Eigen::Matrix3d normal_matrix;
+  normal_matrix << uu, uv, 0, uv, uu + vv, uv, 0, uv, vv;
+  // A robust small solve from Eigen, not the widely copied hand-written 3x3 LDLT (which reads
+  // entries before writing them and biases curvatures low). The matrix is symmetric positive
+  // definite for any non-degenerate triangle, so Cholesky applies; pivoted LDLT takes over if
+  // rounding makes it fail (needle triangles).
+  Eigen::Vector3d solution;
+  const Eigen::LLT<Eigen::Matrix3d> llt(normal_matrix);
+  if (llt.info() == Eigen::Success) {
+    solution = llt.solve(rhs);
+  } else {
+    solution = normal_matrix.ldlt().solve(rhs);
+  }
   if (!solution.allFinite()) return ft;
   ft.e = solution[0];
   ft.f = solution[1];
   ft.g = solution[2];
-  ft.valid = true;
+  ft.n = unit_normal;
   return ft;
 }
 
@@ -123,12 +146,14 @@ Eigen::Vector3d rotate_between(const Eigen::Vector3d& x, const Eigen::Vector3d& 
   return x + wx + w.cross(wx) / (1.0 + c);
 }
 
-// The symmetric tensor (ku, kuv, kv) in the vertex frame (u, v) of a tensor given in another
-// frame (t, b) whose normal has been rotated onto the vertex normal.
-Eigen::Vector3d tensor_in_frame(double e, double f, double g, const Eigen::Vector3d& t, const Eigen::Vector3d& b,
-                                const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
-  const double u1 = u.dot(t), v1 = u.dot(b);
-  const double u2 = v.dot(t), v2 = v.dot(b);
+// The symmetric tensor (ku, kuv, kv) in the vertex frame (u, w = N x u) of a tensor
+// [[e, f], [f, g]] given in the frame (t, N x t) of the same tangent plane. With
+// cos(phi) = u.t and sin(phi) = w.t, the frame change is a plane rotation by phi.
+Eigen::Vector3d tensor_in_frame(double e, double f, double g, const Eigen::Vector3d& t, const Eigen::Vector3d& u,
+                                const Eigen::Vector3d& w) {
+  const double c = u.dot(t), s = w.dot(t);
+  // u = c t - s b and w = s t + c b, where b = N x t.
+  const double u1 = c, v1 = -s, u2 = s, v2 = c;
   return {e * u1 * u1 + 2 * f * u1 * v1 + g * v1 * v1, e * u1 * u2 + f * (u1 * v2 + u2 * v1) + g * v1 * v2,
           e * u2 * u2 + 2 * f * u2 * v2 + g * v2 * v2};
 }
@@ -142,11 +167,20 @@ void diagonalize(const Eigen::Vector3d& tensor, const Eigen::Vector3d& u, const 
                  const Eigen::Vector3d& n, double& k1, double& k2, Eigen::Vector3d& t1, Eigen::Vector3d& t2) {
   const double ku = tensor[0], kuv = tensor[1], kv = tensor[2];
   const double mean = 0.5 * (ku + kv);
-  const double radius = std::hypot(0.5 * (ku - kv), kuv);
+  const double half_difference = 0.5 * (ku - kv);
+  const double radius = std::hypot(half_difference, kuv);
   k1 = mean + radius;
   k2 = mean - radius;
-  const double angle = 0.5 * std::atan2(2 * kuv, ku - kv);  // direction of the larger eigenvalue
-  t1 = std::cos(angle) * u + std::sin(angle) * v;
+  // Eigenvector of k1 in (u, v) coordinates: (radius + half_difference, kuv), or the
+  // equivalent (kuv, radius - half_difference) when that is better conditioned.
+  double x = radius + half_difference, y = kuv;
+  if (half_difference < 0) x = kuv, y = radius - half_difference;
+  const double length = std::hypot(x, y);
+  if (length > 0) {
+    t1 = (x / length) * u + (y / length) * v;
+  } else {  // umbilic: any direction
+    t1 = u;
+  }
   t2 = n.cross(t1);
 }
 
@@ -155,7 +189,8 @@ void diagonalize(const Eigen::Vector3d& tensor, const Eigen::Vector3d& u, const 
 Vertices vertex_normals(const Vertices& V, const Faces& F, NormalWeighting weighting) {
   Vertices N = Vertices::Zero(V.rows(), 3);
   for (Index f = 0; f < F.rows(); ++f) {
-    for (int k = 0; k < 3; ++k) N.row(F(f, k)) += corner_normal(V, F, f, k, weighting).transpose();
+    const FaceGeometry g = face_geometry(V, F, f, weighting);
+    for (int k = 0; k < 3; ++k) N.row(F(f, k)) += g.normal_weight[k] * g.normal.transpose();
   }
   for (Index v = 0; v < V.rows(); ++v) {
     const double length = N.row(v).norm();
@@ -166,7 +201,9 @@ Vertices vertex_normals(const Vertices& V, const Faces& F, NormalWeighting weigh
 
 CornerAreas corner_areas(const Vertices& V, const Faces& F) {
   CornerAreas areas(F.rows(), 3);
-  parallel_range(static_cast<Index>(F.rows()), [&](Index f) { areas.row(f) = face_corner_areas(V, F, f).transpose(); });
+  parallel_range(static_cast<Index>(F.rows()), [&](Index f) {
+    areas.row(f) = face_geometry(V, F, f, NormalWeighting::Area).corner_area.transpose();
+  });
   return areas;
 }
 
@@ -203,17 +240,19 @@ Curvature principal_curvatures(const Vertices& V, const Faces& F, const Topology
     }
   };
 
-  // Pass 1, per face: corner areas.
-  const CornerAreas corner_area = corner_areas(V, F);
+  // Pass 1, per face: normal, normal weights and corner areas.
+  std::vector<FaceGeometry> geometry(static_cast<std::size_t>(nf));
+  parallel_range(nf, [&](Index f) { geometry[static_cast<std::size_t>(f)] = face_geometry(V, F, f, options.normal_weighting); });
 
-  // Pass 2, per vertex: normal, area, and a tangent frame (u, v, N).
+  // Pass 2, per vertex: normal, area, and a tangent frame (u, N x u, N).
   Vertices U(nv, 3);
   parallel_range(nv, [&](Index v) {
     Eigen::Vector3d normal = Eigen::Vector3d::Zero();
     double area = 0;
     for_incident_faces(v, [&](Index f, int k) {
-      normal += corner_normal(V, F, f, k, options.normal_weighting);
-      area += corner_area(f, k);
+      const FaceGeometry& g = geometry[static_cast<std::size_t>(f)];
+      normal += g.normal_weight[k] * g.normal;
+      area += g.corner_area[k];
     });
     const double length = normal.norm();
     normal = length > 0 ? Eigen::Vector3d(normal / length) : Eigen::Vector3d(0, 0, 1);
@@ -226,8 +265,8 @@ Curvature principal_curvatures(const Vertices& V, const Faces& F, const Topology
   std::vector<FaceTensor> face_tensor(static_cast<std::size_t>(nf));
   parallel_range(nf, [&](Index f) { face_tensor[static_cast<std::size_t>(f)] = fit_face_tensor(V, F, c.N, f); });
 
-  // Pass 4, per vertex: area-weighted average of the incident face tensors, each rotated into
-  // the vertex's tangent plane (Rusinkiewicz 2004, section 4).
+  // Pass 4, per vertex: area-weighted average of the incident face tensors, each face's frame
+  // rotated into the vertex's tangent plane (Rusinkiewicz 2004, section 4).
   Vertices tensor = Vertices::Zero(nv, 3);
   parallel_range(nv, [&](Index v) {
     const Eigen::Vector3d n = c.N.row(v).transpose(), u = U.row(v).transpose(), w = n.cross(u);
@@ -235,13 +274,12 @@ Curvature principal_curvatures(const Vertices& V, const Faces& F, const Topology
     double weight = 0;
     for_incident_faces(v, [&](Index f, int k) {
       const FaceTensor& ft = face_tensor[static_cast<std::size_t>(f)];
-      if (!ft.valid || !(corner_area(f, k) > 0)) return;
-      const Eigen::Vector3d face_normal = ft.t.cross(ft.b);
-      if (face_normal.dot(n) <= kFoldedCosine) return;
-      const Eigen::Vector3d t = rotate_between(ft.t, face_normal, n);
-      const Eigen::Vector3d b = rotate_between(ft.b, face_normal, n);
-      sum += corner_area(f, k) * tensor_in_frame(ft.e, ft.f, ft.g, t, b, u, w);
-      weight += corner_area(f, k);
+      const double corner_area = geometry[static_cast<std::size_t>(f)].corner_area[k];
+      // Skip degenerate faces (zero area or failed fit: zero normal) and folded-over ones.
+      if (!(corner_area > 0) || ft.n.squaredNorm() == 0 || ft.n.dot(n) <= kFoldedCosine) return;
+      const Eigen::Vector3d t = rotate_between(ft.t, ft.n, n);
+      sum += corner_area * tensor_in_frame(ft.e, ft.f, ft.g, t, u, w);
+      weight += corner_area;
     });
     if (weight > 0) tensor.row(v) = (sum / weight).transpose();
   });
@@ -258,9 +296,8 @@ Curvature principal_curvatures(const Vertices& V, const Faces& F, const Topology
         const Eigen::Vector3d nj = c.N.row(*j).transpose();
         if (nj.dot(n) <= kFoldedCosine) continue;
         const Eigen::Vector3d uj = rotate_between(U.row(*j).transpose(), nj, n);
-        const Eigen::Vector3d wj = rotate_between(nj.cross(U.row(*j).transpose()), nj, n);
         const Eigen::Vector3d tj = tensor.row(*j).transpose();
-        sum += c.area[*j] * tensor_in_frame(tj[0], tj[1], tj[2], uj, wj, u, w);
+        sum += c.area[*j] * tensor_in_frame(tj[0], tj[1], tj[2], uj, u, w);
         weight += c.area[*j];
       }
       smoothed.row(v) = weight > 0 ? Eigen::RowVector3d(sum.transpose() / weight) : Eigen::RowVector3d(tensor.row(v));
