@@ -9,6 +9,8 @@
 //   order or orientation) and zero-area faces (area < kDegenerateAreaRelative * diagonal^2) are
 //   removed, each counted in ReadReport;
 // - otherwise vertex order is kept, so per-vertex data in the file stays aligned.
+// A mesh whose bounding-box diagonal lies outside [1e-60, 1e60] is refused: squared areas
+// would overflow or underflow in double precision.
 //
 // Every failure throws IoError with a one-line message that starts with the file name.
 // Allocation is bounded by the file's size: a header that claims more elements than the file

@@ -22,6 +22,7 @@ struct PolygonSoup {
   std::vector<std::uint8_t> rgb;              // empty or 3 per vertex
   std::vector<VertexProperty> properties;     // per-vertex scalars other than x, y, z, colours
   bool weld_vertices = false;                 // STL: facets carry their own vertex copies
+  int index_base = 0;                         // how the file numbers vertices (OBJ: 1), for messages
 
   [[nodiscard]] std::int64_t num_vertices() const {
     return static_cast<std::int64_t>(xyz.size() / 3);

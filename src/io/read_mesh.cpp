@@ -18,7 +18,12 @@ namespace vertexflow {
 namespace io_detail {
 
 void fail(const std::string& name, const std::string& message) {
-  throw IoError(name + ": " + message);
+  // A file name may contain control characters (even a newline); the message stays one line.
+  std::string printable_name = name;
+  for (char& c : printable_name) {
+    if (static_cast<unsigned char>(c) < 32) c = '?';
+  }
+  throw IoError(printable_name + ": " + message);
 }
 
 void TextScanner::error(const std::string& message) const {
@@ -84,6 +89,9 @@ std::string gunzip(std::string_view compressed, const std::string& name, std::ui
 }
 
 namespace {
+
+constexpr double kMinDiagonal = 1e-60;
+constexpr double kMaxDiagonal = 1e60;
 
 std::string read_file_bytes(const std::filesystem::path& path) {
   const std::string name = path.string();
@@ -208,8 +216,8 @@ Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& repor
     for (auto c = soup.offsets[static_cast<std::size_t>(p)]; c < soup.offsets[static_cast<std::size_t>(p) + 1]; ++c) {
       const Index v = soup.corners[static_cast<std::size_t>(c)];
       if (v < 0 || v >= nv64)
-        fail(name, fmt::format("face {} references vertex {}, but the file has {} vertices (valid: 0..{})",
-                               p, v, nv64, nv64 - 1));
+        fail(name, fmt::format("face {} references vertex {}, but the file has {} vertices (valid: {}..{})",
+                               p, v + soup.index_base, nv64, soup.index_base, nv64 - 1 + soup.index_base));
     }
   }
   if (soup.weld_vertices) weld_identical_vertices(soup, report);
@@ -277,6 +285,11 @@ Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& repor
   Mesh mesh;
   mesh.V = Eigen::Map<const Vertices>(soup.xyz.data(), nv, 3);
   const double diagonal = bounding_box(mesh.V).diagonal();
+  // Geometry squares lengths twice (areas from squared cross products), so sizes beyond this
+  // range overflow to inf or underflow to 0; real meshes are nowhere near it.
+  if (!(diagonal <= kMaxDiagonal) || (diagonal > 0 && diagonal < kMinDiagonal))
+    fail(name, fmt::format("bounding-box diagonal {:g} is outside the supported range [{:g}, {:g}]", diagonal,
+                           kMinDiagonal, kMaxDiagonal));
   const double min_area = kDegenerateAreaRelative * diagonal * diagonal;
 
   const std::vector<char> duplicate = find_duplicate_faces(tris, nv);

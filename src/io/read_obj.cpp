@@ -13,6 +13,7 @@ namespace vertexflow::io_detail {
 
 PolygonSoup parse_obj(std::string_view bytes, const std::string& name) {
   PolygonSoup soup;
+  soup.index_base = 1;
   TextScanner in(bytes, name);
   // Positive indices may refer to vertices defined later in the file, so they are resolved
   // and range-checked once the whole file is read (soup_to_mesh).

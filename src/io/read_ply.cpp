@@ -196,9 +196,11 @@ class PlyParser {
   void check_count(const Element& element) const {
     const std::uint64_t min_bytes = min_record_bytes(element);
     const std::uint64_t available = bytes_.size() - body_;
-    if (min_bytes > 0 && element.count > (available + 1) / min_bytes)
+    // ASCII: the last record needs no trailing separator, hence the extra byte.
+    const std::uint64_t capacity = min_bytes == 0 ? 0 : (encoding_ == Encoding::Ascii ? available + 1 : available) / min_bytes;
+    if (min_bytes > 0 && element.count > capacity)
       fail(name_, fmt::format("header declares {} '{}' elements, but the remaining {} bytes can hold at most {}",
-                              element.count, element.name, available, (available + 1) / min_bytes));
+                              element.count, element.name, available, capacity));
   }
 
   // --- value access: ASCII tokens or binary bytes, advancing body_ ---
@@ -213,7 +215,7 @@ class PlyParser {
   std::int64_t next_integer(Type type, const char* what) {
     if (encoding_ == Encoding::Ascii) {
       const double v = ascii_value(what);
-      if (v != std::floor(v) || std::abs(v) > 9e15) ascii().error(fmt::format("expected an integer {}", what));
+      if (v != std::floor(v) || std::abs(v) > 9e15) ascii().error(fmt::format("{} must be an integer", what));
       return static_cast<std::int64_t>(v);
     }
     const std::size_t size = type_size(type);

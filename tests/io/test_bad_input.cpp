@@ -66,8 +66,8 @@ const std::map<std::string, std::string> kExpected = {
     // PLY: truncation.
     {"ply_le_truncated_in_vertices.ply", "header declares 8 'vertex' elements, but the remaining 60 bytes"},
     {"ply_be_truncated_in_vertices.ply", "header declares 8 'vertex' elements, but the remaining 60 bytes"},
-    {"ply_le_truncated_in_last_vertex.ply", "unexpected end of file while reading a vertex coordinate"},
-    {"ply_be_truncated_in_last_vertex.ply", "unexpected end of file while reading a vertex coordinate"},
+    {"ply_le_truncated_in_last_vertex.ply", "header declares 8 'vertex' elements, but the remaining 95 bytes can hold at most 7"},
+    {"ply_be_truncated_in_last_vertex.ply", "header declares 8 'vertex' elements, but the remaining 95 bytes can hold at most 7"},
     {"ply_le_truncated_in_faces.ply", "unexpected end of file while reading a face vertex index"},
     {"ply_le_truncated_at_face_boundary.ply", "unexpected end of file while reading list length"},
     {"ply_be_truncated_in_faces.ply", "invalid list length 4 for property 'vertex_indices'"},
@@ -102,7 +102,7 @@ const std::map<std::string, std::string> kExpected = {
     // PLY: values.
     {"fuzz_ply_ascii_colour_out_of_range.ply", "line 25: vertex colour 30020 is outside 0..255"},
     {"ply_ascii_not_a_number.ply", "line 11: expected a vertex coordinate, found 'zero'"},
-    {"ply_ascii_float_index.ply", "line 13: expected an integer"},
+    {"ply_ascii_float_index.ply", "line 13: a face vertex index must be an integer"},
     {"ply_ascii_index_out_of_range.ply", "face 0 references vertex 7, but the file has 3 vertices"},
     {"ply_ascii_face_two_vertices.ply", "face 0 has 2 vertices; a face needs at least 3"},
     {"ply_ascii_nan.ply", "vertex 0 has a non-finite coordinate (nan)"},
@@ -137,7 +137,7 @@ const std::map<std::string, std::string> kExpected = {
     {"off_truncated_ascii.off", "header declares 4 vertices and 4 faces, but the remaining 40 bytes"},
     // OBJ.
     {"obj_index_zero.obj", "line 5: vertex index 0 is invalid (OBJ indices start at 1)"},
-    {"obj_index_out_of_range.obj", "face 0 references vertex 8, but the file has 3 vertices"},
+    {"obj_index_out_of_range.obj", "face 0 references vertex 9, but the file has 3 vertices (valid: 1..3)"},
     {"obj_negative_index_beyond_start.obj", "line 5: vertex index -4 is out of range (3 vertices defined so far)"},
     {"obj_index_too_large.obj", "line 5: vertex index 3000000000 is out of range"},
     {"obj_index_overflow.obj", "line 5: expected a face vertex index, found '99999999999999999999'"},

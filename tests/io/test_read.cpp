@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include <array>
+#include <fstream>
 #include <vector>
 
 namespace vertexflow {
@@ -248,6 +249,30 @@ TEST(ReadPly, AsciiWithColoursAndProperties) {
   const VertexProperty* k1 = mesh.find_vertex_property("k1");
   ASSERT_NE(k1, nullptr);
   EXPECT_EQ(k1->values[1], -1.5);
+}
+
+TEST(ReadMesh, ErrorsStayOnOneLineWhateverTheFileName) {
+  test::ScratchDir dir("newline");
+  const auto path = dir.file("two\nlines.obj");
+  { std::ofstream(path) << "v 0 0 0\n"; }
+  try {
+    read_mesh(path);
+    FAIL();
+  } catch (const IoError& e) {
+    const std::string message = e.what();
+    EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+    EXPECT_NE(message.find("two?lines.obj: the file contains no faces"), std::string::npos) << message;
+  }
+}
+
+TEST(ReadMesh, CoordinatesWhoseSquaresOverflowOrUnderflowAreRefused) {
+  const std::string huge = "v 0 0 0\nv 1e70 0 0\nv 0 1e70 0\nf 1 2 3\n";
+  const std::string tiny = "v 0 0 0\nv 1e-70 0 0\nv 0 1e-70 0\nf 1 2 3\n";
+  EXPECT_THROW(read_text(huge, MeshFormat::Obj), IoError);
+  EXPECT_THROW(read_text(tiny, MeshFormat::Obj), IoError);
+  // Large and small but representable scales are fine.
+  EXPECT_EQ(read_text("v 0 0 0\nv 1e50 0 0\nv 0 1e50 0\nf 1 2 3\n", MeshFormat::Obj).num_faces(), 1);
+  EXPECT_EQ(read_text("v 0 0 0\nv 1e-50 0 0\nv 0 1e-50 0\nf 1 2 3\n", MeshFormat::Obj).num_faces(), 1);
 }
 
 TEST(ReadPly, AsciiRecordsMustMatchTheHeaderLineByLine) {
