@@ -98,8 +98,9 @@ FaceTensor fit_face_tensor(const Vertices& V, const Faces& F, const Vertices& N,
   const Eigen::Vector3d normal = (p[1] - p[0]).cross(p[2] - p[0]);
   const double edge = (p[2] - p[1]).norm();
   if (!(normal.norm() > 0) || !(edge > 0)) return ft;
-  ft.t = (p[2] - p[1]) / edge;
-  const Eigen::Vector3d unit_normal = normal.normalized();
+  // Reciprocals: one division instead of three per normalised vector (this is the hot loop).
+  ft.t = (p[2] - p[1]) * (1.0 / edge);
+  const Eigen::Vector3d unit_normal = normal * (1.0 / normal.norm());
   const Eigen::Vector3d b = unit_normal.cross(ft.t);
   // Normal equations of the rows (u, v, 0) . (e, f, g) = dN.t and (0, u, v) . (e, f, g) = dN.b,
   // accumulated directly rather than through a 6 x 3 matrix.
@@ -143,7 +144,7 @@ Eigen::Vector3d rotate_between(const Eigen::Vector3d& x, const Eigen::Vector3d& 
   const Eigen::Vector3d w = from.cross(to);
   const double c = from.dot(to);
   const Eigen::Vector3d wx = w.cross(x);
-  return x + wx + w.cross(wx) / (1.0 + c);
+  return x + wx + w.cross(wx) * (1.0 / (1.0 + c));
 }
 
 // The symmetric tensor (ku, kuv, kv) in the vertex frame (u, w = N x u) of a tensor
@@ -168,16 +169,19 @@ void diagonalize(const Eigen::Vector3d& tensor, const Eigen::Vector3d& u, const 
   const double ku = tensor[0], kuv = tensor[1], kv = tensor[2];
   const double mean = 0.5 * (ku + kv);
   const double half_difference = 0.5 * (ku - kv);
-  const double radius = std::hypot(half_difference, kuv);
+  // Plain square roots: the operands are curvatures of a mesh whose size read_mesh bounds, far
+  // from overflow, and std::hypot's care costs more than the rest of this function.
+  const double radius = std::sqrt(half_difference * half_difference + kuv * kuv);
   k1 = mean + radius;
   k2 = mean - radius;
   // Eigenvector of k1 in (u, v) coordinates: (radius + half_difference, kuv), or the
   // equivalent (kuv, radius - half_difference) when that is better conditioned.
   double x = radius + half_difference, y = kuv;
   if (half_difference < 0) x = kuv, y = radius - half_difference;
-  const double length = std::hypot(x, y);
+  const double length = std::sqrt(x * x + y * y);
   if (length > 0) {
-    t1 = (x / length) * u + (y / length) * v;
+    const double inverse = 1.0 / length;
+    t1 = (x * inverse) * u + (y * inverse) * v;
   } else {  // umbilic: any direction
     t1 = u;
   }
@@ -255,7 +259,7 @@ Curvature principal_curvatures(const Vertices& V, const Faces& F, const Topology
       area += g.corner_area[k];
     });
     const double length = normal.norm();
-    normal = length > 0 ? Eigen::Vector3d(normal / length) : Eigen::Vector3d(0, 0, 1);
+    normal = length > 0 ? Eigen::Vector3d(normal * (1.0 / length)) : Eigen::Vector3d(0, 0, 1);
     c.N.row(v) = normal.transpose();
     c.area[v] = area;
     U.row(v) = normal.unitOrthogonal().transpose();
