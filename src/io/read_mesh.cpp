@@ -4,14 +4,17 @@
 
 #include <zlib.h>
 
+#include <fcntl.h>
+#include <fmt/format.h>
+#include <sys/stat.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <unistd.h>
 #include <algorithm>
 #include <array>
 #include <cerrno>
 #include <cmath>
-#include <fcntl.h>
-#include <fmt/format.h>
-#include <sys/stat.h>
-#include <unistd.h>
+#include <memory>
 #include <unordered_map>
 
 namespace vertexflow {
@@ -93,7 +96,14 @@ namespace {
 constexpr double kMinDiagonal = 1e-60;
 constexpr double kMaxDiagonal = 1e60;
 
-std::string read_file_bytes(const std::filesystem::path& path) {
+// The bytes of a file, in a buffer that is not zero-filled first (read() overwrites it).
+struct FileBytes {
+  std::unique_ptr<char[]> data;
+  std::size_t size = 0;
+  [[nodiscard]] std::string_view view() const { return {data.get(), size}; }
+};
+
+FileBytes read_file_bytes(const std::filesystem::path& path) {
   const std::string name = path.string();
   // O_NONBLOCK: opening a FIFO (e.g. "pipe.obj") for reading would otherwise block until a
   // writer appears; this way it opens at once and is refused below as not a regular file.
@@ -114,11 +124,12 @@ std::string read_file_bytes(const std::filesystem::path& path) {
     ::close(fd);
     fail(name, "is not a regular file");
   }
-  std::string bytes;
-  bytes.resize(static_cast<std::size_t>(st.st_size));
+  FileBytes bytes;
+  bytes.size = static_cast<std::size_t>(st.st_size);
+  bytes.data.reset(new char[std::max<std::size_t>(bytes.size, 1)]);
   std::size_t done = 0;
-  while (done < bytes.size()) {
-    const ssize_t n = ::read(fd, bytes.data() + done, bytes.size() - done);
+  while (done < bytes.size) {
+    const ssize_t n = ::read(fd, bytes.data.get() + done, bytes.size - done);
     if (n < 0) {
       if (errno == EINTR) continue;
       const int err = errno;
@@ -129,7 +140,7 @@ std::string read_file_bytes(const std::filesystem::path& path) {
     done += static_cast<std::size_t>(n);
   }
   ::close(fd);
-  bytes.resize(done);
+  bytes.size = done;
   return bytes;
 }
 
@@ -152,16 +163,35 @@ std::vector<char> find_duplicate_faces(const std::vector<Index>& tris, Index num
     for (std::size_t f = 0; f < nf; ++f) order[static_cast<std::size_t>(fill[keys[f][0]]++)] = static_cast<Index>(f);
   }
   std::vector<char> duplicate(nf, 0);
-  for (std::size_t v = 0; v < static_cast<std::size_t>(num_vertices); ++v) {
-    const auto begin = order.begin() + start[v];
-    const auto end = order.begin() + start[v + 1];
-    if (end - begin < 2) continue;
-    // Faces within a bucket are in increasing face order, so the first of equal keys is kept.
-    std::stable_sort(begin, end, [&](Index a, Index b) { return keys[a] < keys[b]; });
-    for (auto it = begin + 1; it != end; ++it) {
-      if (keys[*it] == keys[*(it - 1)]) duplicate[static_cast<std::size_t>(*it)] = 1;
-    }
-  }
+  // Buckets are independent and each writes only its own faces' flags: parallel and
+  // deterministic.
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, static_cast<std::size_t>(num_vertices), 8192),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t v = range.begin(); v != range.end(); ++v) {
+                        const auto begin = order.begin() + start[v];
+                        const auto end = order.begin() + start[v + 1];
+                        if (end - begin < 2) continue;
+                        // Faces within a bucket are in increasing face order, so the first of equal keys is kept.
+                        // Buckets hold about six faces: an insertion sort (stable, no allocation) beats
+                        // std::stable_sort, which allocates a buffer per call.
+                        const auto less = [&](Index a, Index b) {
+                          return keys[static_cast<std::size_t>(a)] < keys[static_cast<std::size_t>(b)];
+                        };
+                        if (end - begin <= 32) {
+                          for (auto it = begin + 1; it != end; ++it) {
+                            const Index value = *it;
+                            auto hole = it;
+                            for (; hole != begin && less(value, *(hole - 1)); --hole) *hole = *(hole - 1);
+                            *hole = value;
+                          }
+                        } else {
+                          std::stable_sort(begin, end, less);
+                        }
+                        for (auto it = begin + 1; it != end; ++it) {
+                          if (keys[*it] == keys[*(it - 1)]) duplicate[static_cast<std::size_t>(*it)] = 1;
+                        }
+                      }
+                    });
   return duplicate;
 }
 
@@ -188,8 +218,9 @@ void weld_identical_vertices(PolygonSoup& soup, ReadReport& report) {
       std::memcpy(&key[static_cast<std::size_t>(c)], &x, sizeof(double));
     }
     const auto [it, inserted] = index_of.try_emplace(key, static_cast<Index>(welded.size() / 3));
-    if (inserted) welded.insert(welded.end(), soup.xyz.begin() + 3 * static_cast<std::ptrdiff_t>(v),
-                                soup.xyz.begin() + 3 * static_cast<std::ptrdiff_t>(v) + 3);
+    if (inserted)
+      welded.insert(welded.end(), soup.xyz.begin() + 3 * static_cast<std::ptrdiff_t>(v),
+                    soup.xyz.begin() + 3 * static_cast<std::ptrdiff_t>(v) + 3);
     remap[v] = it->second;
   }
   for (auto& c : soup.corners) c = remap[static_cast<std::size_t>(c)];
@@ -199,8 +230,7 @@ void weld_identical_vertices(PolygonSoup& soup, ReadReport& report) {
 
 }  // namespace
 
-Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& report,
-                  const ReadOptions& options) {
+Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& report, const ReadOptions& options) {
   const std::int64_t nv64 = soup.num_vertices();
   if (nv64 == 0) fail(name, "the file contains no vertices");
   if (soup.num_polygons() == 0) fail(name, "the file contains no faces");
@@ -216,29 +246,35 @@ Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& repor
     for (auto c = soup.offsets[static_cast<std::size_t>(p)]; c < soup.offsets[static_cast<std::size_t>(p) + 1]; ++c) {
       const Index v = soup.corners[static_cast<std::size_t>(c)];
       if (v < 0 || v >= nv64)
-        fail(name, fmt::format("face {} references vertex {}, but the file has {} vertices (valid: {}..{})",
-                               p, v + soup.index_base, nv64, soup.index_base, nv64 - 1 + soup.index_base));
+        fail(name, fmt::format("face {} references vertex {}, but the file has {} vertices (valid: {}..{})", p,
+                               v + soup.index_base, nv64, soup.index_base, nv64 - 1 + soup.index_base));
     }
   }
   if (soup.weld_vertices) weld_identical_vertices(soup, report);
   const Index nv = static_cast<Index>(soup.num_vertices());
 
-  // Triangulate, dropping faces with fewer than three distinct vertices.
+  // Triangulate, dropping faces with fewer than three distinct vertices. A file of triangles
+  // only (the common case) hands its corner list over as it is.
   std::vector<Index> tris;
-  tris.reserve(soup.corners.size());
   std::vector<Index> polygon;
   EdgeSet edges;  // filled only when the file has polygons
   const bool has_polygons = soup.corners.size() != 3 * static_cast<std::size_t>(soup.num_polygons());
-  if (has_polygons) {
+  if (!has_polygons) {
+    tris = std::move(soup.corners);
+    soup.offsets = {0};  // nothing left for the polygon loop below
+  } else {
+    tris.reserve(soup.corners.size());
     for (std::int64_t p = 0; p < soup.num_polygons(); ++p) {
       const auto begin = soup.offsets[static_cast<std::size_t>(p)], end = soup.offsets[static_cast<std::size_t>(p) + 1];
       for (auto c = begin; c < end; ++c)
-        edges.insert(edge_key(soup.corners[static_cast<std::size_t>(c)], soup.corners[static_cast<std::size_t>(c + 1 < end ? c + 1 : begin)]));
+        edges.insert(edge_key(soup.corners[static_cast<std::size_t>(c)],
+                              soup.corners[static_cast<std::size_t>(c + 1 < end ? c + 1 : begin)]));
     }
   }
   for (std::int64_t p = 0; p < soup.num_polygons(); ++p) {
     const Index* c = soup.corners.data() + soup.offsets[static_cast<std::size_t>(p)];
-    const std::size_t n = static_cast<std::size_t>(soup.offsets[static_cast<std::size_t>(p) + 1] - soup.offsets[static_cast<std::size_t>(p)]);
+    const std::size_t n = static_cast<std::size_t>(soup.offsets[static_cast<std::size_t>(p) + 1] -
+                                                   soup.offsets[static_cast<std::size_t>(p)]);
     if (n == 3) {
       if (c[0] == c[1] || c[1] == c[2] || c[2] == c[0]) {
         ++report.repeated_index_faces_removed;
@@ -264,8 +300,7 @@ Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& repor
       continue;
     }
     ++report.polygons_triangulated;
-    if (!triangulate_polygon(soup.xyz.data(), polygon.data(), polygon.size(), edges, tris))
-      ++report.polygons_fanned;
+    if (!triangulate_polygon(soup.xyz.data(), polygon.data(), polygon.size(), edges, tris)) ++report.polygons_fanned;
   }
   // Fanning a polygon with a repeated corner can create triangles with a repeated index.
   {
@@ -293,22 +328,29 @@ Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& repor
   const double min_area = kDegenerateAreaRelative * diagonal * diagonal;
 
   const std::vector<char> duplicate = find_duplicate_faces(tris, nv);
+  std::vector<char> zero_area(tris.size() / 3, 0);
+  if (options.remove_zero_area_faces) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tris.size() / 3, 16384), [&](const auto& range) {
+      for (std::size_t f = range.begin(); f != range.end(); ++f) {
+        const Eigen::Vector3d a = mesh.V.row(tris[3 * f]);
+        const Eigen::Vector3d b = mesh.V.row(tris[3 * f + 1]);
+        const Eigen::Vector3d c = mesh.V.row(tris[3 * f + 2]);
+        zero_area[f] = 0.5 * (b - a).cross(c - a).norm() < min_area;
+      }
+    });
+  }
   std::size_t kept = 0;
   for (std::size_t f = 0; f < tris.size() / 3; ++f) {
     if (duplicate[f]) {
       ++report.duplicate_faces_removed;
       continue;
     }
-    if (options.remove_zero_area_faces) {
-      const Eigen::Vector3d a = mesh.V.row(tris[3 * f]);
-      const Eigen::Vector3d b = mesh.V.row(tris[3 * f + 1]);
-      const Eigen::Vector3d c = mesh.V.row(tris[3 * f + 2]);
-      if (0.5 * (b - a).cross(c - a).norm() < min_area) {
-        ++report.zero_area_faces_removed;
-        continue;
-      }
+    if (zero_area[f]) {
+      ++report.zero_area_faces_removed;
+      continue;
     }
-    for (int k = 0; k < 3; ++k) tris[3 * kept + static_cast<std::size_t>(k)] = tris[3 * f + static_cast<std::size_t>(k)];
+    for (int k = 0; k < 3; ++k)
+      tris[3 * kept + static_cast<std::size_t>(k)] = tris[3 * f + static_cast<std::size_t>(k)];
     ++kept;
   }
   if (kept == 0) fail(name, "no valid faces remain (all faces are degenerate or repeated)");
@@ -328,7 +370,8 @@ Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& repor
     report.unreferenced_vertices_removed += nv - used;
     auto compact_rows = [&](auto& matrix) {
       for (Index v = 0; v < nv; ++v) {
-        if (new_index[static_cast<std::size_t>(v)] >= 0) matrix.row(new_index[static_cast<std::size_t>(v)]) = matrix.row(v);
+        if (new_index[static_cast<std::size_t>(v)] >= 0)
+          matrix.row(new_index[static_cast<std::size_t>(v)]) = matrix.row(v);
       }
       matrix.conservativeResize(used, Eigen::NoChange);
     };
@@ -336,11 +379,13 @@ Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& repor
     if (mesh.colors.rows() > 0) compact_rows(mesh.colors);
     for (auto& property : mesh.vertex_properties) {
       for (Index v = 0; v < nv; ++v) {
-        if (new_index[static_cast<std::size_t>(v)] >= 0) property.values[new_index[static_cast<std::size_t>(v)]] = property.values[v];
+        if (new_index[static_cast<std::size_t>(v)] >= 0)
+          property.values[new_index[static_cast<std::size_t>(v)]] = property.values[v];
       }
       property.values.conservativeResize(used);
     }
-    for (Eigen::Index i = 0; i < mesh.F.size(); ++i) mesh.F.data()[i] = new_index[static_cast<std::size_t>(mesh.F.data()[i])];
+    for (Eigen::Index i = 0; i < mesh.F.size(); ++i)
+      mesh.F.data()[i] = new_index[static_cast<std::size_t>(mesh.F.data()[i])];
   }
   return mesh;
 }
@@ -362,8 +407,9 @@ MeshFormat format_from_path(const std::filesystem::path& path) {
   if (ext == ".ply") return MeshFormat::Ply;
   if (ext == ".off") return MeshFormat::Off;
   if (ext == ".stl") return MeshFormat::Stl;
-  io_detail::fail(path.string(), ext.empty() ? "no file extension; expected .obj, .ply, .off or .stl (optionally .gz)"
-                                             : "unknown extension '" + ext + "'; expected .obj, .ply, .off or .stl (optionally .gz)");
+  io_detail::fail(path.string(),
+                  ext.empty() ? "no file extension; expected .obj, .ply, .off or .stl (optionally .gz)"
+                              : "unknown extension '" + ext + "'; expected .obj, .ply, .off or .stl (optionally .gz)");
 }
 
 std::vector<std::string> ReadReport::warnings() const {
@@ -381,8 +427,8 @@ std::vector<std::string> ReadReport::warnings() const {
   return out;
 }
 
-Mesh read_mesh_from_memory(std::string_view bytes, MeshFormat format, const std::string& name,
-                           ReadReport* report, const ReadOptions& options) {
+Mesh read_mesh_from_memory(std::string_view bytes, MeshFormat format, const std::string& name, ReadReport* report,
+                           const ReadOptions& options) {
   ReadReport local;
   ReadReport& r = report ? *report : local;
   r = ReadReport{};
@@ -396,10 +442,18 @@ Mesh read_mesh_from_memory(std::string_view bytes, MeshFormat format, const std:
   if (bytes.empty()) io_detail::fail(name, "the file is empty");
   io_detail::PolygonSoup soup;
   switch (format) {
-    case MeshFormat::Obj: soup = io_detail::parse_obj(bytes, name); break;
-    case MeshFormat::Ply: soup = io_detail::parse_ply(bytes, name, r); break;
-    case MeshFormat::Off: soup = io_detail::parse_off(bytes, name, r); break;
-    case MeshFormat::Stl: soup = io_detail::parse_stl(bytes, name, r); break;
+    case MeshFormat::Obj:
+      soup = io_detail::parse_obj(bytes, name);
+      break;
+    case MeshFormat::Ply:
+      soup = io_detail::parse_ply(bytes, name, r);
+      break;
+    case MeshFormat::Off:
+      soup = io_detail::parse_off(bytes, name, r);
+      break;
+    case MeshFormat::Stl:
+      soup = io_detail::parse_stl(bytes, name, r);
+      break;
   }
   inflated = std::string();  // free the text before building the mesh
   return io_detail::soup_to_mesh(std::move(soup), name, r, options);
@@ -407,8 +461,8 @@ Mesh read_mesh_from_memory(std::string_view bytes, MeshFormat format, const std:
 
 Mesh read_mesh(const std::filesystem::path& path, ReadReport* report, const ReadOptions& options) {
   const MeshFormat format = format_from_path(path);
-  const std::string bytes = io_detail::read_file_bytes(path);
-  return read_mesh_from_memory(bytes, format, path.string(), report, options);
+  const io_detail::FileBytes bytes = io_detail::read_file_bytes(path);
+  return read_mesh_from_memory(bytes.view(), format, path.string(), report, options);
 }
 
 }  // namespace vertexflow
