@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <numeric>
 #include <stdexcept>
 #include <string>
@@ -187,19 +188,24 @@ Topology build_topology(const Faces& F, Index num_vertices) {
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
   };
+  // Each vertex's list is computed once into a scratch area sized by its corner count (a
+  // vertex with d incident faces has at most 2d neighbours), then compacted.
   std::vector<Index> edge_counts(static_cast<std::size_t>(nv));
+  std::vector<Index> scratch_neighbours(2 * t.vertex_faces.size());
   parallel_vertices(nv, [&](Index v, std::vector<Index>& scratch) {
     larger_neighbours(v, scratch);
+    std::copy(scratch.begin(), scratch.end(), scratch_neighbours.begin() + 2 * t.face_offsets[static_cast<std::size_t>(v)]);
     edge_counts[static_cast<std::size_t>(v)] = static_cast<Index>(scratch.size());
   });
   const std::vector<Index> edge_offsets = offsets_from_counts(edge_counts);
   const Index ne = edge_offsets.back();
   t.edges.resize(ne, 2);
-  parallel_vertices(nv, [&](Index v, std::vector<Index>& scratch) {
-    larger_neighbours(v, scratch);
+  parallel_vertices(nv, [&](Index v, std::vector<Index>&) {
+    const Index* source = scratch_neighbours.data() + 2 * t.face_offsets[static_cast<std::size_t>(v)];
     Index e = edge_offsets[static_cast<std::size_t>(v)];
-    for (const Index w : scratch) t.edges(e, 0) = v, t.edges(e, 1) = w, ++e;
+    for (Index i = 0; i < edge_counts[static_cast<std::size_t>(v)]; ++i, ++e) t.edges(e, 0) = v, t.edges(e, 1) = source[i];
   });
+  scratch_neighbours = std::vector<Index>();
   auto find_edge = [&](Index a, Index b) {
     if (a > b) std::swap(a, b);
     const Index* first = t.edges.data() + 2 * edge_offsets[static_cast<std::size_t>(a)];
@@ -226,21 +232,25 @@ Topology build_topology(const Faces& F, Index num_vertices) {
     }
   }
   t.face_adjacency.resize(nf, 3);
-  for (Index f = 0; f < nf; ++f) {
-    for (int k = 0; k < 3; ++k) {
-      const auto e = static_cast<std::size_t>(t.face_edges(f, k));
-      Index other = -1;
-      if (t.edge_face_count[e] == 2) {
-        other = edge_face[2 * e] == f ? edge_face[2 * e + 1] : edge_face[2 * e];
-        // Consistent orientation: the neighbour runs the shared edge the other way.
-        const Index a = F(f, k), b = F(f, (k + 1) % 3);
-        for (int j = 0; j < 3; ++j) {
-          if (F(other, j) == a && F(other, (j + 1) % 3) == b) t.is_oriented = false;
+  std::atomic<bool> oriented{true};
+  tbb::parallel_for(tbb::blocked_range<Index>(0, nf, 8192), [&](const tbb::blocked_range<Index>& r) {
+    for (Index f = r.begin(); f != r.end(); ++f) {
+      for (int k = 0; k < 3; ++k) {
+        const auto e = static_cast<std::size_t>(t.face_edges(f, k));
+        Index other = -1;
+        if (t.edge_face_count[e] == 2) {
+          other = edge_face[2 * e] == f ? edge_face[2 * e + 1] : edge_face[2 * e];
+          // Consistent orientation: the neighbour runs the shared edge the other way.
+          const Index a = F(f, k), b = F(f, (k + 1) % 3);
+          for (int j = 0; j < 3; ++j) {
+            if (F(other, j) == a && F(other, (j + 1) % 3) == b) oriented.store(false, std::memory_order_relaxed);
+          }
         }
+        t.face_adjacency(f, k) = other;
       }
-      t.face_adjacency(f, k) = other;
     }
-  }
+  });
+  t.is_oriented = oriented.load();
   for (Index e = 0; e < ne; ++e) {
     if (t.edge_face_count[static_cast<std::size_t>(e)] > 2) t.non_manifold_edges.push_back(e);
   }
