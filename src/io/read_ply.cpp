@@ -39,30 +39,21 @@ std::size_t type_size(Type t) {
 
 bool is_integer(Type t) { return t != Type::Float32 && t != Type::Float64; }
 
-double load_value(const char* p, Type t, bool swap) {
+// One value of type t, converted to R. List counts and indices are read with R = int64 (the
+// header check guarantees their types are integers).
+template <class R>
+R load_as(const char* p, Type t, bool swap) {
   switch (t) {
-    case Type::Int8: return static_cast<std::int8_t>(*p);
-    case Type::UInt8: return static_cast<std::uint8_t>(*p);
-    case Type::Int16: return load_scalar<std::int16_t>(p, swap);
-    case Type::UInt16: return load_scalar<std::uint16_t>(p, swap);
-    case Type::Int32: return load_scalar<std::int32_t>(p, swap);
-    case Type::UInt32: return load_scalar<std::uint32_t>(p, swap);
-    case Type::Float32: return load_scalar<float>(p, swap);
-    case Type::Float64: return load_scalar<double>(p, swap);
+    case Type::Int8: return static_cast<R>(static_cast<std::int8_t>(*p));
+    case Type::UInt8: return static_cast<R>(static_cast<std::uint8_t>(*p));
+    case Type::Int16: return static_cast<R>(load_scalar<std::int16_t>(p, swap));
+    case Type::UInt16: return static_cast<R>(load_scalar<std::uint16_t>(p, swap));
+    case Type::Int32: return static_cast<R>(load_scalar<std::int32_t>(p, swap));
+    case Type::UInt32: return static_cast<R>(load_scalar<std::uint32_t>(p, swap));
+    case Type::Float32: return static_cast<R>(load_scalar<float>(p, swap));
+    case Type::Float64: return static_cast<R>(load_scalar<double>(p, swap));
   }
   return 0;
-}
-
-std::int64_t load_integer(const char* p, Type t, bool swap) {
-  switch (t) {
-    case Type::Int8: return static_cast<std::int8_t>(*p);
-    case Type::UInt8: return static_cast<std::uint8_t>(*p);
-    case Type::Int16: return load_scalar<std::int16_t>(p, swap);
-    case Type::UInt16: return load_scalar<std::uint16_t>(p, swap);
-    case Type::Int32: return load_scalar<std::int32_t>(p, swap);
-    case Type::UInt32: return load_scalar<std::uint32_t>(p, swap);
-    default: return 0;  // list counts and indices are integer types (checked in the header)
-  }
 }
 
 struct Property {
@@ -208,7 +199,7 @@ class PlyParser {
     if (encoding_ == Encoding::Ascii) return ascii_value(what);
     const std::size_t size = type_size(type);
     if (body_ + size > bytes_.size()) truncated(what);
-    const double v = load_value(bytes_.data() + body_, type, swap_);
+    const double v = load_as<double>(bytes_.data() + body_, type, swap_);
     body_ += size;
     return v;
   }
@@ -220,7 +211,7 @@ class PlyParser {
     }
     const std::size_t size = type_size(type);
     if (body_ + size > bytes_.size()) truncated(what);
-    const std::int64_t v = load_integer(bytes_.data() + body_, type, swap_);
+    const std::int64_t v = load_as<std::int64_t>(bytes_.data() + body_, type, swap_);
     body_ += size;
     return v;
   }

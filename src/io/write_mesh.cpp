@@ -128,6 +128,25 @@ class Output {
   std::string buffer_;
 };
 
+// "PREFIX x y z" (shortest round-trip digits), without the newline.
+void append_position(std::string& b, const char* prefix, const Mesh& mesh, Index v, bool as_float = false) {
+  b += prefix;
+  for (int c = 0; c < 3; ++c) {
+    if (c > 0) b += ' ';
+    append_double(b, as_float ? static_cast<float>(mesh.V(v, c)) : mesh.V(v, c));
+  }
+}
+
+// "PREFIX i j k\n" with indices offset by `base` (OBJ counts from 1).
+void append_face(std::string& b, const char* prefix, const Mesh& mesh, Index f, Index base = 0) {
+  b += prefix;
+  for (int c = 0; c < 3; ++c) {
+    if (c > 0) b += ' ';
+    append_int(b, mesh.F(f, c) + base);
+  }
+  b += '\n';
+}
+
 bool has_colors(const Mesh& mesh, const WriteOptions& options) {
   return options.write_colors && mesh.colors.rows() == mesh.V.rows() && mesh.colors.rows() > 0;
 }
@@ -136,23 +155,12 @@ void write_obj(Output& out, const Mesh& mesh) {
   std::string& b = out.buffer();
   b += "# written by vertexflow\n";
   for (Index v = 0; v < mesh.num_vertices(); ++v) {
-    b += "v ";
-    append_double(b, mesh.V(v, 0));
-    b += ' ';
-    append_double(b, mesh.V(v, 1));
-    b += ' ';
-    append_double(b, mesh.V(v, 2));
+    append_position(b, "v ", mesh, v);
     b += '\n';
     out.maybe_flush();
   }
   for (Index f = 0; f < mesh.num_faces(); ++f) {
-    b += "f ";
-    append_int(b, mesh.F(f, 0) + 1);
-    b += ' ';
-    append_int(b, mesh.F(f, 1) + 1);
-    b += ' ';
-    append_int(b, mesh.F(f, 2) + 1);
-    b += '\n';
+    append_face(b, "f ", mesh, f, 1);
     out.maybe_flush();
   }
 }
@@ -185,22 +193,13 @@ void write_off(Output& out, const Mesh& mesh, const WriteOptions& options) {
   b += colors ? "COFF\n" : "OFF\n";
   b += fmt::format("{} {} 0\n", mesh.num_vertices(), mesh.num_faces());
   for (Index v = 0; v < mesh.num_vertices(); ++v) {
-    for (int c = 0; c < 3; ++c) {
-      if (c > 0) b += ' ';
-      append_double(b, mesh.V(v, c));
-    }
+    append_position(b, "", mesh, v);
     if (colors) b += fmt::format(" {} {} {} 255", mesh.colors(v, 0), mesh.colors(v, 1), mesh.colors(v, 2));
     b += '\n';
     out.maybe_flush();
   }
   for (Index f = 0; f < mesh.num_faces(); ++f) {
-    b += "3 ";
-    append_int(b, mesh.F(f, 0));
-    b += ' ';
-    append_int(b, mesh.F(f, 1));
-    b += ' ';
-    append_int(b, mesh.F(f, 2));
-    b += '\n';
+    append_face(b, "3 ", mesh, f);
     out.maybe_flush();
   }
 }
@@ -230,10 +229,7 @@ void write_ply(Output& out, const Mesh& mesh, const WriteOptions& options) {
 
   if (options.ply_encoding == PlyEncoding::Ascii) {
     for (Index v = 0; v < mesh.num_vertices(); ++v) {
-      for (int c = 0; c < 3; ++c) {
-        if (c > 0) b += ' ';
-        append_double(b, options.ply_double_precision ? mesh.V(v, c) : static_cast<float>(mesh.V(v, c)));
-      }
+      append_position(b, "", mesh, v, !options.ply_double_precision);
       if (colors) b += fmt::format(" {} {} {}", mesh.colors(v, 0), mesh.colors(v, 1), mesh.colors(v, 2));
       for (const auto* p : properties) {
         b += ' ';
@@ -243,13 +239,7 @@ void write_ply(Output& out, const Mesh& mesh, const WriteOptions& options) {
       out.maybe_flush();
     }
     for (Index f = 0; f < mesh.num_faces(); ++f) {
-      b += "3 ";
-      append_int(b, mesh.F(f, 0));
-      b += ' ';
-      append_int(b, mesh.F(f, 1));
-      b += ' ';
-      append_int(b, mesh.F(f, 2));
-      b += '\n';
+      append_face(b, "3 ", mesh, f);
       out.maybe_flush();
     }
     return;

@@ -45,7 +45,7 @@ TEST(CliInfo, JsonHasTheSameNumbers) {
   EXPECT_EQ(j["read"]["format"], "OFF (ASCII)");
 }
 
-TEST(CliInfo, NonManifoldIsReported) {
+TEST(CliInfo, PolygonMeshWarningsAndTopology) {
   const auto r = run_cli("info --json " + data("suzanne.obj"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
