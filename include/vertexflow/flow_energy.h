@@ -1,0 +1,89 @@
+// The energy of the vertex flow (paper sections 3-4), term by term, and its assembly as one
+// sparse linear least-squares system.
+//
+// Notation: V = current positions (the unknowns), P = positions of the input mesh M0 (the
+// proxy of the surface), and per vertex i the input's principal curvatures k_i1, k_i2 with
+// unit directions T_i1, T_i2 and normal N_i, all frozen during a solve.
+//
+//   K_i     = |k_i1| T_i1 T_i1^T + |k_i2| T_i2 T_i2^T                        (3x3, PSD)
+//   f_em(e) = 1/2 (e_ij^T K_i e_ij + e_ji^T K_j e_ji),  e_ij = v_j - v_i      (Eq. 2-4)
+//   F_em    = 1/|E| sum_e f_em(e)                                            (Eq. 5)
+//   g_i     = sum_{j in N(i)} (K_i + K_j)(v_i - v_j) = |E| grad_{v_i} F_em  (Eq. 16)
+//   F_tan   = 1/|E| sum_i [(T_i1 . g_i)^2 + (T_i2 . g_i)^2]                  (Eq. 13-15, 19)
+//   h_i(v)  = c_i1 ((v - p_i).T_i1)^2 + c_i2 ((v - p_i).T_i2)^2 + ((v - p_i).N_i)^2,
+//             c = d / (d + rho) = d |k| / (d |k| + 1), rho = 1 / |k|            (Eq. 6)
+//   F_sd    = 1/|V| sum_i h_i(v_i)                                           (Eq. 7)
+//   L(v_i)  = v_i - 1/deg(i) sum_{j in N(i)} v_j                             (Eq. 8)
+//   F_smo   = 1/|V| sum_i mu_i |L(v_i)|^2,  mu_i = exp(-(|k_i1| + |k_i2|))  (Eq. 9-10)
+//
+// The system minimises F_tan + lambda F_sd + mu F_smo + epsilon lambda 1/|V| sum |v_i - p_i|^2.
+// Two choices the paper leaves open are made here (../docs: method-notes):
+// - F_em enters through its tangential gradient (Eq. 13-19) with weight 1/|E| on the squared
+//   rows, the same per-element averaging as F_sd's 1/|V|, so the balance of the terms does not
+//   depend on the resolution. (The paper's literal F_em has its minimum at a collapsed mesh.)
+// - F_smo is normalised by 1/|V| like F_sd (the paper gives no normalisation; unnormalised it
+//   outweighs F_sd by |V| and shrinks the mesh), and epsilon (default 1e-6) keeps the system
+//   definite where a vertex is flat (k = 0 gives it no tangential constraint otherwise).
+// The terms are not scale-invariant by themselves: curvature has units 1/length. The flow
+// evaluates them on a copy scaled to mean edge length 1 (flow.h).
+#pragma once
+
+#include "vertexflow/curvature.h"
+#include "vertexflow/mesh.h"
+#include "vertexflow/topology.h"
+
+#include <Eigen/SparseCore>
+
+namespace vertexflow {
+
+/// The frozen per-vertex data of the energy: the input's positions and curvature.
+struct FlowFrame {
+  Vertices P;          ///< input positions p_i
+  Curvature curvature; ///< of the input, at the same scale as P
+  double d = 1;        ///< the radius d of Eq. 6 (same length unit as P)
+};
+
+/// Weights of the terms.
+struct EnergyWeights {
+  double lambda = 1.0;    ///< weight of F_sd (Eq. 1)
+  double mu = 0.5;        ///< weight of F_smo (Eq. 1)
+  double epsilon = 1e-6;  ///< isotropic pull, relative to lambda
+};
+
+/// F_em of Eq. 2-5 at positions V (the paper's literal edge energy; not what is minimised).
+double edge_metric_energy(const Vertices& V, const Topology& topology, const FlowFrame& frame);
+
+/// g_i of every vertex at positions V (#V x 3): |E| times the gradient of F_em.
+Vertices edge_metric_gradient(const Vertices& V, const Topology& topology, const FlowFrame& frame);
+
+/// F_tan: the tangential part of F_em's gradient, squared and averaged (Eq. 13-19).
+double tangential_edge_energy(const Vertices& V, const Topology& topology, const FlowFrame& frame);
+
+/// F_sd of Eq. 6-7 at positions V.
+double squared_distance_energy(const Vertices& V, const FlowFrame& frame);
+
+/// F_smo of Eq. 8-10 at positions V (with the 1/|V| normalisation above).
+double fairness_energy(const Vertices& V, const Topology& topology, const FlowFrame& frame);
+
+/// The whole objective F_tan + lambda F_sd + mu F_smo + epsilon lambda / |V| sum |v - p|^2.
+double total_flow_energy(const Vertices& V, const Topology& topology, const FlowFrame& frame,
+                         const EnergyWeights& weights);
+
+/// A linear least-squares system ||A x - b||^2 over x = (x_0, y_0, z_0, x_1, ...): 3 #V columns.
+struct LeastSquaresSystem {
+  Eigen::SparseMatrix<double, Eigen::RowMajor> A;
+  Eigen::VectorXd b;
+};
+
+/// Assembles the rows of every term (2 + 3 + 3 + 3 per vertex) so that ||A x - b||^2 equals
+/// total_flow_energy at the positions x.
+LeastSquaresSystem assemble_flow_system(const Topology& topology, const FlowFrame& frame,
+                                        const EnergyWeights& weights);
+
+/// Coefficients c = d |k| / (d |k| + 1) of Eq. 6 for a curvature k (0 where k = 0).
+inline double distance_coefficient(double d, double k) {
+  const double dk = d * std::abs(k);
+  return dk / (dk + 1.0);
+}
+
+}  // namespace vertexflow

@@ -1,0 +1,181 @@
+// The flow's energy terms (include/vertexflow/flow_energy.h), evaluated directly from the
+// paper's formulas and assembled as least-squares rows. The direct evaluations are what the
+// tests hold the assembly against.
+#include "vertexflow/flow_energy.h"
+
+#include <cmath>
+#include <vector>
+
+namespace vertexflow {
+namespace {
+
+Eigen::Vector3d row3(const Vertices& M, Index i) { return M.row(i).transpose(); }
+
+// K_i = |k_i1| T_i1 T_i1^T + |k_i2| T_i2 T_i2^T (Eq. 2 written as a quadratic form).
+Eigen::Matrix3d curvature_tensor(const Curvature& c, Index i) {
+  const Eigen::Vector3d t1 = row3(c.T1, i), t2 = row3(c.T2, i);
+  return std::abs(c.k1[i]) * t1 * t1.transpose() + std::abs(c.k2[i]) * t2 * t2.transpose();
+}
+
+// Eq. 10.
+double fairness_weight(const Curvature& c, Index i) { return std::exp(-(std::abs(c.k1[i]) + std::abs(c.k2[i]))); }
+
+// h_i(v) of Eq. 6.
+double squared_distance(const FlowFrame& frame, Index i, const Eigen::Vector3d& v) {
+  const Curvature& c = frame.curvature;
+  const Eigen::Vector3d r = v - row3(frame.P, i);
+  const double a = r.dot(row3(c.T1, i)), b = r.dot(row3(c.T2, i)), n = r.dot(row3(c.N, i));
+  return distance_coefficient(frame.d, c.k1[i]) * a * a + distance_coefficient(frame.d, c.k2[i]) * b * b + n * n;
+}
+
+// L(v_i) of Eq. 8 (zero for an isolated vertex).
+Eigen::Vector3d laplacian(const Vertices& V, const Topology& topology, Index i) {
+  const auto [begin, end] = topology.ring(i);
+  if (begin == end) return Eigen::Vector3d::Zero();
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Index* j = begin; j != end; ++j) mean += row3(V, *j);
+  return row3(V, i) - mean / static_cast<double>(end - begin);
+}
+
+}  // namespace
+
+double edge_metric_energy(const Vertices& V, const Topology& topology, const FlowFrame& frame) {
+  double sum = 0;
+  for (Index e = 0; e < topology.num_edges(); ++e) {
+    const Index i = topology.edges(e, 0), j = topology.edges(e, 1);
+    const Eigen::Vector3d eij = row3(V, j) - row3(V, i);
+    const Curvature& c = frame.curvature;
+    // Eq. 2 and 3 with the directions of each endpoint; Eq. 4 averages them.
+    const double fi = std::abs(c.k1[i]) * std::pow(eij.dot(row3(c.T1, i)), 2) +
+                      std::abs(c.k2[i]) * std::pow(eij.dot(row3(c.T2, i)), 2);
+    const double fj = std::abs(c.k1[j]) * std::pow(eij.dot(row3(c.T1, j)), 2) +
+                      std::abs(c.k2[j]) * std::pow(eij.dot(row3(c.T2, j)), 2);
+    sum += 0.5 * (fi + fj);
+  }
+  return topology.num_edges() > 0 ? sum / topology.num_edges() : 0.0;
+}
+
+Vertices edge_metric_gradient(const Vertices& V, const Topology& topology, const FlowFrame& frame) {
+  Vertices g = Vertices::Zero(V.rows(), 3);
+  for (Index i = 0; i < static_cast<Index>(V.rows()); ++i) {
+    const Eigen::Matrix3d Ki = curvature_tensor(frame.curvature, i);
+    const auto [begin, end] = topology.ring(i);
+    Eigen::Vector3d gi = Eigen::Vector3d::Zero();
+    for (const Index* j = begin; j != end; ++j)
+      gi += (Ki + curvature_tensor(frame.curvature, *j)) * (row3(V, i) - row3(V, *j));
+    g.row(i) = gi.transpose();
+  }
+  return g;
+}
+
+double tangential_edge_energy(const Vertices& V, const Topology& topology, const FlowFrame& frame) {
+  const Vertices g = edge_metric_gradient(V, topology, frame);
+  double sum = 0;
+  for (Index i = 0; i < static_cast<Index>(V.rows()); ++i) {
+    sum += std::pow(g.row(i).dot(frame.curvature.T1.row(i)), 2) + std::pow(g.row(i).dot(frame.curvature.T2.row(i)), 2);
+  }
+  return topology.num_edges() > 0 ? sum / topology.num_edges() : 0.0;
+}
+
+double squared_distance_energy(const Vertices& V, const FlowFrame& frame) {
+  double sum = 0;
+  for (Index i = 0; i < static_cast<Index>(V.rows()); ++i) sum += squared_distance(frame, i, row3(V, i));
+  return V.rows() > 0 ? sum / static_cast<double>(V.rows()) : 0.0;
+}
+
+double fairness_energy(const Vertices& V, const Topology& topology, const FlowFrame& frame) {
+  double sum = 0;
+  for (Index i = 0; i < static_cast<Index>(V.rows()); ++i)
+    sum += fairness_weight(frame.curvature, i) * laplacian(V, topology, i).squaredNorm();
+  return V.rows() > 0 ? sum / static_cast<double>(V.rows()) : 0.0;
+}
+
+double total_flow_energy(const Vertices& V, const Topology& topology, const FlowFrame& frame,
+                         const EnergyWeights& weights) {
+  const double n = static_cast<double>(V.rows());
+  const double pull = n > 0 ? (V - frame.P).squaredNorm() / n : 0.0;
+  return tangential_edge_energy(V, topology, frame) + weights.lambda * squared_distance_energy(V, frame) +
+         weights.mu * fairness_energy(V, topology, frame) + weights.epsilon * weights.lambda * pull;
+}
+
+LeastSquaresSystem assemble_flow_system(const Topology& topology, const FlowFrame& frame,
+                                        const EnergyWeights& weights) {
+  const Index n = static_cast<Index>(frame.P.rows());
+  const Curvature& c = frame.curvature;
+  const double nv = std::max<double>(n, 1);
+  const double w_em = topology.num_edges() > 0 ? std::sqrt(1.0 / topology.num_edges()) : 0.0;
+  const double w_sd = std::sqrt(weights.lambda / nv);
+  const double w_pull = std::sqrt(weights.epsilon * weights.lambda / nv);
+
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(static_cast<std::size_t>(n) * 60 + topology.ring_vertices.size() * 9);
+  std::vector<double> rhs;
+  rhs.reserve(static_cast<std::size_t>(n) * 11);
+  Index row = 0;
+  auto add_block_row = [&](Index r, Index vertex, const Eigen::RowVector3d& coefficients) {
+    for (int k = 0; k < 3; ++k) {
+      if (coefficients[k] != 0) triplets.emplace_back(r, 3 * vertex + k, coefficients[k]);
+    }
+  };
+
+  std::vector<Eigen::Matrix3d> K(static_cast<std::size_t>(n));
+  for (Index i = 0; i < n; ++i) K[static_cast<std::size_t>(i)] = curvature_tensor(c, i);
+
+  for (Index i = 0; i < n; ++i) {
+    const auto [begin, end] = topology.ring(i);
+    const Eigen::Vector3d t[2] = {row3(c.T1, i), row3(c.T2, i)};
+    const Eigen::Vector3d p = row3(frame.P, i);
+
+    // F_tan (Eq. 13-19): rows T_ia . g_i, with g_i = sum_j (K_i + K_j)(v_i - v_j).
+    for (const Eigen::Vector3d& ta : t) {
+      Eigen::RowVector3d own = Eigen::RowVector3d::Zero();
+      for (const Index* j = begin; j != end; ++j) {
+        const Eigen::RowVector3d coupling = ta.transpose() * (K[static_cast<std::size_t>(i)] + K[static_cast<std::size_t>(*j)]);
+        own += coupling;
+        add_block_row(row, *j, -w_em * coupling);
+      }
+      add_block_row(row, i, w_em * own);
+      rhs.push_back(0.0);
+      ++row;
+    }
+
+    // lambda F_sd (Eq. 6-7): sqrt(c_a) T_a . (v - p) and N . (v - p).
+    const double coefficient[2] = {distance_coefficient(frame.d, c.k1[i]), distance_coefficient(frame.d, c.k2[i])};
+    for (int a = 0; a < 2; ++a) {
+      const double w = w_sd * std::sqrt(coefficient[a]);
+      add_block_row(row, i, w * t[a].transpose());
+      rhs.push_back(w * t[a].dot(p));
+      ++row;
+    }
+    const Eigen::Vector3d normal = row3(c.N, i);
+    add_block_row(row, i, w_sd * normal.transpose());
+    rhs.push_back(w_sd * normal.dot(p));
+    ++row;
+
+    // mu F_smo (Eq. 8-10): one row per coordinate.
+    if (begin != end) {
+      const double w = std::sqrt(weights.mu * fairness_weight(c, i) / nv);
+      const double share = w / static_cast<double>(end - begin);
+      for (int k = 0; k < 3; ++k) {
+        triplets.emplace_back(row, 3 * i + k, w);
+        for (const Index* j = begin; j != end; ++j) triplets.emplace_back(row, 3 * *j + k, -share);
+        rhs.push_back(0.0);
+        ++row;
+      }
+    }
+
+    // The isotropic pull.
+    for (int k = 0; k < 3; ++k) {
+      triplets.emplace_back(row, 3 * i + k, w_pull);
+      rhs.push_back(w_pull * p[k]);
+      ++row;
+    }
+  }
+  LeastSquaresSystem system;
+  system.A.resize(row, 3 * n);
+  system.A.setFromTriplets(triplets.begin(), triplets.end());
+  system.b = Eigen::Map<const Eigen::VectorXd>(rhs.data(), static_cast<Eigen::Index>(rhs.size()));
+  return system;
+}
+
+}  // namespace vertexflow
