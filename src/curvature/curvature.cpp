@@ -138,6 +138,10 @@ FaceTensor fit_face_tensor(const Vertices& V, const Faces& F, const Vertices& N,
   return ft;
 }
 
+// The first axis of a vertex's tangent frame (u, N x u, N): any unit vector orthogonal to N,
+// chosen from N alone so every pass derives the same frame without storing it.
+Eigen::Vector3d vertex_frame(const Eigen::Vector3d& n) { return n.unitOrthogonal(); }
+
 // Rotates x by the smallest rotation taking unit vector `from` to unit vector `to`
 // (Rodrigues: R x = x + w x x + w x (w x x) / (1 + from.to), w = from x to).
 Eigen::Vector3d rotate_between(const Eigen::Vector3d& x, const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
@@ -244,62 +248,63 @@ Curvature principal_curvatures(const Vertices& V, const Faces& F, const Topology
     }
   };
 
-  // Pass 1, per face: normal, normal weights and corner areas.
-  std::vector<FaceGeometry> geometry(static_cast<std::size_t>(nf));
-  parallel_range(nf, [&](Index f) { geometry[static_cast<std::size_t>(f)] = face_geometry(V, F, f, options.normal_weighting); });
-
-  // Pass 2, per vertex: normal, area, and a tangent frame (u, N x u, N).
-  Vertices U(nv, 3);
+  // Pass 1, per vertex: normal and mixed area, gathered from the incident faces (each face's
+  // geometry is recomputed per corner: cheaper than storing it for every face).
   parallel_range(nv, [&](Index v) {
     Eigen::Vector3d normal = Eigen::Vector3d::Zero();
     double area = 0;
     for_incident_faces(v, [&](Index f, int k) {
-      const FaceGeometry& g = geometry[static_cast<std::size_t>(f)];
+      const FaceGeometry g = face_geometry(V, F, f, options.normal_weighting);
       normal += g.normal_weight[k] * g.normal;
       area += g.corner_area[k];
     });
     const double length = normal.norm();
-    normal = length > 0 ? Eigen::Vector3d(normal * (1.0 / length)) : Eigen::Vector3d(0, 0, 1);
-    c.N.row(v) = normal.transpose();
+    c.N.row(v) = length > 0 ? Eigen::RowVector3d(normal.transpose() * (1.0 / length)) : Eigen::RowVector3d(0, 0, 1);
     c.area[v] = area;
-    U.row(v) = normal.unitOrthogonal().transpose();
   });
 
-  // Pass 3, per face: the fitted second fundamental form.
-  std::vector<FaceTensor> face_tensor(static_cast<std::size_t>(nf));
-  parallel_range(nf, [&](Index f) { face_tensor[static_cast<std::size_t>(f)] = fit_face_tensor(V, F, c.N, f); });
+  // Pass 2, per face: fit the second fundamental form (Rusinkiewicz 2004, section 3) and
+  // rotate it into the tangent frame of each of its three vertices (section 4). Each corner's
+  // record is (area-weighted tensor in the vertex frame, area).
+  std::vector<Eigen::Vector4d> corner_record(3 * static_cast<std::size_t>(nf));
+  parallel_range(nf, [&](Index f) {
+    const FaceTensor ft = fit_face_tensor(V, F, c.N, f);
+    const FaceGeometry g = face_geometry(V, F, f, options.normal_weighting);
+    for (int k = 0; k < 3; ++k) {
+      Eigen::Vector4d& record = corner_record[3 * static_cast<std::size_t>(f) + static_cast<std::size_t>(k)];
+      const Eigen::Vector3d n = c.N.row(F(f, k)).transpose();
+      // Skip degenerate faces (zero area or failed fit: zero normal) and folded-over ones.
+      if (!(g.corner_area[k] > 0) || ft.n.squaredNorm() == 0 || ft.n.dot(n) <= kFoldedCosine) {
+        record.setZero();
+        continue;
+      }
+      const Eigen::Vector3d u = vertex_frame(n);
+      const Eigen::Vector3d t = rotate_between(ft.t, ft.n, n);
+      record << g.corner_area[k] * tensor_in_frame(ft.e, ft.f, ft.g, t, u, n.cross(u)), g.corner_area[k];
+    }
+  });
 
-  // Pass 4, per vertex: area-weighted average of the incident face tensors, each face's frame
-  // rotated into the vertex's tangent plane (Rusinkiewicz 2004, section 4).
+  // Pass 3, per vertex: the area-weighted mean of its corners' tensors.
   Vertices tensor = Vertices::Zero(nv, 3);
   parallel_range(nv, [&](Index v) {
-    const Eigen::Vector3d n = c.N.row(v).transpose(), u = U.row(v).transpose(), w = n.cross(u);
-    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-    double weight = 0;
-    for_incident_faces(v, [&](Index f, int k) {
-      const FaceTensor& ft = face_tensor[static_cast<std::size_t>(f)];
-      const double corner_area = geometry[static_cast<std::size_t>(f)].corner_area[k];
-      // Skip degenerate faces (zero area or failed fit: zero normal) and folded-over ones.
-      if (!(corner_area > 0) || ft.n.squaredNorm() == 0 || ft.n.dot(n) <= kFoldedCosine) return;
-      const Eigen::Vector3d t = rotate_between(ft.t, ft.n, n);
-      sum += corner_area * tensor_in_frame(ft.e, ft.f, ft.g, t, u, w);
-      weight += corner_area;
-    });
-    if (weight > 0) tensor.row(v) = (sum / weight).transpose();
+    Eigen::Vector4d sum = Eigen::Vector4d::Zero();
+    for_incident_faces(v, [&](Index f, int k) { sum += corner_record[3 * static_cast<std::size_t>(f) + static_cast<std::size_t>(k)]; });
+    if (sum[3] > 0) tensor.row(v) = sum.head<3>().transpose() * (1.0 / sum[3]);
   });
+  corner_record = std::vector<Eigen::Vector4d>();
 
   // Optional smoothing: average each tensor with its neighbours', transported likewise.
   for (int round = 0; round < options.smoothing_rounds; ++round) {
     Vertices smoothed(nv, 3);
     parallel_range(nv, [&](Index v) {
-      const Eigen::Vector3d n = c.N.row(v).transpose(), u = U.row(v).transpose(), w = n.cross(u);
+      const Eigen::Vector3d n = c.N.row(v).transpose(), u = vertex_frame(n), w = n.cross(u);
       Eigen::Vector3d sum = c.area[v] * tensor.row(v).transpose();
       double weight = c.area[v];
       const auto [begin, end] = topology.ring(v);
       for (const Index* j = begin; j != end; ++j) {
         const Eigen::Vector3d nj = c.N.row(*j).transpose();
         if (nj.dot(n) <= kFoldedCosine) continue;
-        const Eigen::Vector3d uj = rotate_between(U.row(*j).transpose(), nj, n);
+        const Eigen::Vector3d uj = rotate_between(vertex_frame(nj), nj, n);
         const Eigen::Vector3d tj = tensor.row(*j).transpose();
         sum += c.area[*j] * tensor_in_frame(tj[0], tj[1], tj[2], uj, u, w);
         weight += c.area[*j];
@@ -309,9 +314,9 @@ Curvature principal_curvatures(const Vertices& V, const Faces& F, const Topology
     tensor = std::move(smoothed);
   }
 
-  // Pass 5, per vertex: principal curvatures and directions.
+  // Pass 4, per vertex: principal curvatures and directions.
   parallel_range(nv, [&](Index v) {
-    const Eigen::Vector3d n = c.N.row(v).transpose(), u = U.row(v).transpose(), w = n.cross(u);
+    const Eigen::Vector3d n = c.N.row(v).transpose(), u = vertex_frame(n), w = n.cross(u);
     double k1 = 0, k2 = 0;
     Eigen::Vector3d t1, t2;
     diagonalize(tensor.row(v).transpose(), u, w, n, k1, k2, t1, t2);
