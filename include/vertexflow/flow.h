@@ -1,0 +1,82 @@
+// Vertex flow (Ji, Liu, Wang, Wang 2011): vertices slide over the surface towards curved
+// regions, connectivity unchanged, by minimising F_total = F_em + lambda F_sd + mu F_smo
+// (flow_energy.h) in one sparse least-squares solve.
+//
+// Scale and rigid motion: the flow runs on a copy translated to its centroid and scaled to
+// mean edge length 1, where curvature times edge length is dimensionless and the balance of
+// the terms does not depend on the mesh's size or resolution (method-notes, "Scale"). The
+// result is mapped back, so flowing a rotated, translated, uniformly scaled mesh gives the
+// same transform of the result.
+//
+// Guarantees: boundary vertices (when fix_boundary) and pinned vertices do not move; no face
+// turns by more than 90 degrees relative to the input and no face becomes degenerate. A face
+// that would is repaired by halving the displacement of its vertices (per vertex, repeatedly,
+// like CGAL's tangential relaxation step control); FlowReport counts the vertices limited.
+// Non-manifold meshes are refused (std::invalid_argument), as topology.h states.
+#pragma once
+
+#include "vertexflow/curvature.h"
+#include "vertexflow/mesh.h"
+
+#include <string>
+#include <vector>
+
+namespace vertexflow {
+
+struct FlowOptions {
+  /// Weight of the distance term F_sd: the user's "strength" knob, inverted. Smaller lets the
+  /// vertices move further (stronger enhancement); useful range about 0.2 (strong) to 50
+  /// (almost no change); 1 is the paper's default.
+  double lambda = 1.0;
+  /// Weight of the fairness term F_smo (paper: 0.5). 0 removes it, which leaves flat regions
+  /// unconstrained (method-notes: "mu > 0 is required").
+  double mu = 0.5;
+  /// Isotropic pull towards the input, relative to lambda: keeps the system definite at flat
+  /// vertices, where neither F_em nor F_sd constrains tangential motion.
+  double epsilon = 1e-6;
+  /// d of Eq. 6 is the principal curvature radius at this percentile of |k| (largest
+  /// curvatures). 100 is the paper's literal "minimum radius of all vertices", which a single
+  /// noisy vertex of a scan decides; 99 gives the same result on clean meshes and less drift
+  /// on scans (method-notes, point 4).
+  double d_percentile = 99.0;
+  /// Solves, each with curvature recomputed on the previous result. One by default: repeated
+  /// solves kept lowering triangle quality without converging (method-notes, point 5).
+  int iterations = 1;
+  /// Keep boundary vertices where they are (paper, section 6).
+  bool fix_boundary = true;
+  /// Vertices held in place (indices into V).
+  std::vector<Index> pinned;
+  /// Halvings of a vertex's displacement before it is set to zero by the flip guard.
+  int max_halvings = 30;
+  /// Relative tolerance of the conjugate-gradient solve.
+  double solver_tolerance = 1e-10;
+  CurvatureOptions curvature;
+};
+
+struct FlowReport {
+  double mean_edge_length = 0;       ///< of the input: the unit of the normalised problem
+  double d = 0;                      ///< d of Eq. 6, in input units
+  int solver_iterations = 0;         ///< conjugate-gradient iterations (sum over solves)
+  double solver_error = 0;           ///< relative residual of the last solve
+  Index flipped_before_guard = 0;    ///< faces the unguarded solution turned or degenerated
+  Index limited_vertices = 0;        ///< vertices whose displacement the guard shortened
+  Index fixed_vertices = 0;          ///< boundary and pinned vertices
+  double seconds_curvature = 0, seconds_assembly = 0, seconds_solve = 0, seconds_guard = 0;
+};
+
+struct FlowResult {
+  Vertices V;  ///< new positions; faces are unchanged
+  FlowReport report;
+};
+
+/// Moves the vertices of (V, F) by vertex flow. Throws std::invalid_argument for an empty or
+/// non-manifold mesh, or a pinned index out of range.
+FlowResult vertex_flow(const Vertices& V, const Faces& F, const FlowOptions& options = {});
+
+/// Faces whose normal turned by more than 90 degrees from `before` to `after` (same faces).
+std::vector<Index> flipped_faces(const Vertices& before, const Vertices& after, const Faces& F);
+
+/// Faces with area below kDegenerateAreaRelative * (bounding-box diagonal of V)^2.
+std::vector<Index> degenerate_faces(const Vertices& V, const Faces& F);
+
+}  // namespace vertexflow

@@ -1,0 +1,114 @@
+// vertex_flow end to end on real meshes: the guarantees (no flips, no degenerate faces, fixed
+// and pinned vertices stay), invariance under similarity transforms, the lambda knob, volume.
+#include "test_support.h"
+
+#include "vertexflow/flow.h"
+#include "vertexflow/io.h"
+#include "vertexflow/quality.h"
+
+#include <gtest/gtest.h>
+
+namespace vertexflow {
+namespace {
+
+double signed_volume(const Vertices& V, const Faces& F) {
+  double volume = 0;
+  for (Index f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+    volume += a.dot(b.cross(c)) / 6.0;
+  }
+  return volume;
+}
+
+double mean_displacement(const Vertices& a, const Vertices& b) { return (a - b).rowwise().norm().mean(); }
+
+class FlowOnMesh : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(FlowOnMesh, NoFlippedOrDegenerateFacesAndFixedBoundary) {
+  const Mesh mesh = read_mesh(test::data_path(GetParam()));
+  const FlowResult result = vertex_flow(mesh.V, mesh.F);
+  EXPECT_TRUE(flipped_faces(mesh.V, result.V, mesh.F).empty());
+  EXPECT_TRUE(degenerate_faces(result.V, mesh.F).empty());
+  EXPECT_TRUE(result.V.allFinite());
+  // The flow moved something, but not far: displacement in mean edge lengths.
+  const double moved = mean_displacement(result.V, mesh.V) / result.report.mean_edge_length;
+  EXPECT_GT(moved, 0.01);
+  EXPECT_LT(moved, 1.0);
+  const Topology topology = build_topology(mesh.F, mesh.num_vertices());
+  for (Index v = 0; v < mesh.num_vertices(); ++v) {
+    if (topology.is_boundary_vertex[static_cast<std::size_t>(v)]) {
+      ASSERT_EQ(result.V.row(v), mesh.V.row(v)) << v;
+    }
+  }
+  if (topology.is_closed()) {
+    const double before = signed_volume(mesh.V, mesh.F), after = signed_volume(result.V, mesh.F);
+    EXPECT_LT(std::abs(after - before), 0.005 * std::abs(before));
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Data, FlowOnMesh,
+                         ::testing::Values("bunny_uniform.off", "fandisk.off", "max-planck-5k.obj", "hemisphere.off",
+                                           "camelhead.off"),
+                         [](const auto& param_info) { return test::test_name(param_info.param); });
+
+TEST(Flow, SimilarityTransformCommutes) {
+  const Mesh mesh = read_mesh(test::data_path("spot.obj"));
+  const FlowResult base = vertex_flow(mesh.V, mesh.F);
+  const double s = 3.7;
+  const Eigen::Matrix3d R = Eigen::AngleAxisd(0.9, Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix();
+  const Eigen::RowVector3d t(5, -1, 12);
+  auto transform = [&](const Vertices& X) -> Vertices { return (s * (X * R.transpose())).rowwise() + t; };
+  const FlowResult moved = vertex_flow(transform(mesh.V), mesh.F);
+  const double scale = s * bounding_box(mesh.V).diagonal();
+  EXPECT_LE((moved.V - transform(base.V)).cwiseAbs().maxCoeff(), 1e-6 * scale);
+}
+
+TEST(Flow, PinnedVerticesStay) {
+  const Mesh mesh = read_mesh(test::data_path("bunny_uniform.off"));
+  FlowOptions options;
+  const FlowResult free_result = vertex_flow(mesh.V, mesh.F, options);
+  // Pin the vertices that moved most.
+  Eigen::VectorXd moved = (free_result.V - mesh.V).rowwise().norm();
+  for (int k = 0; k < 5; ++k) {
+    Index worst = 0;
+    moved.maxCoeff(&worst);
+    options.pinned.push_back(worst);
+    moved[worst] = -1;
+  }
+  const FlowResult pinned = vertex_flow(mesh.V, mesh.F, options);
+  for (const Index v : options.pinned) EXPECT_EQ(pinned.V.row(v), mesh.V.row(v)) << v;
+  EXPECT_EQ(pinned.report.fixed_vertices, 5);
+  FlowOptions out_of_range;
+  out_of_range.pinned = {mesh.num_vertices()};
+  EXPECT_THROW(vertex_flow(mesh.V, mesh.F, out_of_range), std::invalid_argument);
+}
+
+TEST(Flow, LargerLambdaMovesLess) {
+  const Mesh mesh = read_mesh(test::data_path("bunny_uniform.off"));
+  double previous = std::numeric_limits<double>::infinity();
+  for (const double lambda : {0.2, 1.0, 10.0, 50.0}) {
+    FlowOptions options;
+    options.lambda = lambda;
+    const double moved = mean_displacement(vertex_flow(mesh.V, mesh.F, options).V, mesh.V);
+    EXPECT_LT(moved, previous) << "lambda " << lambda;
+    previous = moved;
+  }
+}
+
+TEST(Flow, RefusesNonManifoldAndEmptyMeshes) {
+  Mesh bowtie;
+  bowtie.V.resize(5, 3);
+  bowtie.V << 0, 0, 0, 1, 0, 0, 0, 1, 0, -1, 0, 0, 0, -1, 0;
+  bowtie.F.resize(2, 3);
+  bowtie.F << 0, 1, 2, 0, 3, 4;
+  EXPECT_THROW(vertex_flow(bowtie.V, bowtie.F), std::invalid_argument);
+  EXPECT_THROW(vertex_flow(Vertices(), Faces()), std::invalid_argument);
+}
+
+TEST(Flow, DeterministicBetweenRuns) {
+  const Mesh mesh = read_mesh(test::data_path("max-planck-5k.obj"));
+  EXPECT_EQ(vertex_flow(mesh.V, mesh.F).V, vertex_flow(mesh.V, mesh.F).V);
+}
+
+}  // namespace
+}  // namespace vertexflow
