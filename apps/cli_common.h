@@ -31,5 +31,6 @@ nlohmann::json to_json(const ReadReport& report);
 /// Registers the subcommands (one function per command file).
 void register_info_command(CLI::App& app, const GlobalOptions& global);
 void register_curvature_command(CLI::App& app, const GlobalOptions& global);
+void register_enhance_command(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace vertexflow::cli

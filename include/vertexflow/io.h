@@ -23,6 +23,7 @@
 #include <filesystem>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace vertexflow {
@@ -103,9 +104,13 @@ struct WriteOptions {
 void write_mesh(const std::filesystem::path& path, const Mesh& mesh,
                 const WriteOptions& options = {});
 
+/// Writes `text` to `path` atomically (temporary file beside it, then rename). Throws IoError.
+void write_text_file(const std::filesystem::path& path, std::string_view text);
+
 /// Throws IoError unless `output` is safe to write while `input` is being processed: it must
-/// not be the same file as the input (unless `force`), and must not be a directory.
+/// not be the same file as the input (unless `force`), must not be a directory and, when
+/// `mesh_output`, must have a mesh extension.
 void check_output_path(const std::filesystem::path& input, const std::filesystem::path& output,
-                       bool force);
+                       bool force, bool mesh_output = true);
 
 }  // namespace vertexflow

@@ -324,10 +324,19 @@ void write_mesh(const std::filesystem::path& path, const Mesh& mesh, const Write
   out.commit();
 }
 
-void check_output_path(const std::filesystem::path& input, const std::filesystem::path& output, bool force) {
+void write_text_file(const std::filesystem::path& path, std::string_view text) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) io_detail::fail(path.string(), "is a directory");
+  io_detail::Output out(path, false);
+  out.buffer().append(text);
+  out.commit();
+}
+
+void check_output_path(const std::filesystem::path& input, const std::filesystem::path& output, bool force,
+                       bool mesh_output) {
   std::error_code ec;
   if (std::filesystem::is_directory(output, ec)) io_detail::fail(output.string(), "is a directory, not an output file");
-  format_from_path(output);
+  if (mesh_output) format_from_path(output);
   if (!force && std::filesystem::exists(output, ec) && std::filesystem::equivalent(input, output, ec))
     io_detail::fail(output.string(), "is the input file; refusing to overwrite it (use --force to allow)");
 }

@@ -123,3 +123,54 @@ TEST(CliCurvature, RefusesToOverwriteTheInputAndNonManifoldMeshes) {
 
 }  // namespace
 }  // namespace vertexflow
+
+namespace vertexflow {
+namespace {
+
+TEST(CliEnhance, WritesTheMeshAndAReport) {
+  test::ScratchDir dir("cli-enhance");
+  const auto out = dir.file("bunny.ply");
+  const auto report = dir.file("report.json");
+  const auto pins = dir.file("pins.txt");
+  { std::ofstream(pins) << "# hold two vertices\n17 4000\n"; }
+  const auto r = run_cli("enhance " + data("bunny_uniform.off") + " " + shell_quote(out.string()) + " --pin " +
+                         shell_quote(pins.string()) + " --report " + shell_quote(report.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Mesh input = read_mesh(test::data_path("bunny_uniform.off"));
+  const Mesh result = read_mesh(out);
+  ASSERT_EQ(result.F, input.F);
+  EXPECT_EQ(result.V.row(17), input.V.row(17));
+  EXPECT_EQ(result.V.row(4000), input.V.row(4000));
+  EXPECT_GT((result.V - input.V).rowwise().norm().maxCoeff(), 0.0);
+  const auto j = nlohmann::json::parse(test::read_text(report));
+  EXPECT_EQ(j["flipped_faces"], 0);
+  EXPECT_EQ(j["degenerate_faces"], 0);
+  EXPECT_EQ(j["options"]["pinned"], 2);
+  // The flow redistributes vertices towards curved regions and evens out the edge errors.
+  EXPECT_GT(j["redistribution_rho"]["result"].get<double>(), j["redistribution_rho"]["input"].get<double>() + 0.2);
+  EXPECT_LT(j["edge_error_cv"]["result"].get<double>(), 0.9 * j["edge_error_cv"]["input"].get<double>());
+  for (const char* phase : {"read", "curvature", "assembly", "solve", "guard", "write"})
+    EXPECT_GE(j["seconds"][phase].get<double>(), 0.0) << phase;
+}
+
+TEST(CliEnhance, BadPinFileAndNonManifoldInputFailCleanly) {
+  test::ScratchDir dir("cli-enhance-bad");
+  const auto pins = dir.file("pins.txt");
+  { std::ofstream(pins) << "12 banana\n"; }
+  const auto out = dir.file("out.off");
+  const auto r = run_cli("enhance " + data("spot.obj") + " " + shell_quote(out.string()) + " --pin " +
+                         shell_quote(pins.string()));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("line 1: 'banana' is not a vertex index"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+  const auto bowtie = dir.file("bowtie.obj");
+  { std::ofstream(bowtie) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv -1 0 0\nv 0 -1 0\nf 1 2 3\nf 1 4 5\n"; }
+  const auto nm = run_cli("--quiet enhance " + shell_quote(bowtie.string()) + " " + shell_quote(out.string()));
+  EXPECT_EQ(nm.exit_code, 1);
+  EXPECT_NE(nm.err.find("bowtie.obj: vertex flow: the mesh is not manifold"), std::string::npos) << nm.err;
+  EXPECT_EQ(std::count(nm.err.begin(), nm.err.end(), '\n'), 1) << nm.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+}  // namespace
+}  // namespace vertexflow

@@ -1,0 +1,155 @@
+// `vertexflow enhance IN OUT [...]`: vertex flow (paper sections 3-4), with a JSON report of
+// what it did.
+#include "cli_common.h"
+
+#include "vertexflow/flow.h"
+#include "vertexflow/metrics.h"
+#include "vertexflow/quality.h"
+
+#include <fmt/format.h>
+
+#include <chrono>
+#include <fstream>
+#include <sstream>
+
+namespace vertexflow::cli {
+namespace {
+
+struct EnhanceOptions {
+  std::string input;
+  std::string output;
+  std::string pin_file;
+  std::string report_file;
+  FlowOptions flow;
+  bool keep_boundary_free = false;
+  bool force = false;
+};
+
+// Vertex indices (0-based), separated by white space; '#' starts a comment.
+std::vector<Index> read_pins(const std::string& path, Index num_vertices) {
+  std::ifstream in(path);
+  if (!in) throw IoError(path + ": cannot open the pin file");
+  std::vector<Index> pins;
+  std::string line;
+  for (int number = 1; std::getline(in, line); ++number) {
+    line = line.substr(0, line.find('#'));
+    std::istringstream words(line);
+    std::string word;
+    while (words >> word) {
+      long long value = -1;
+      std::size_t used = 0;
+      try {
+        value = std::stoll(word, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != word.size() || value < 0 || value >= num_vertices)
+        throw IoError(fmt::format("{}: line {}: '{}' is not a vertex index of the input (0..{})", path, number, word,
+                                  num_vertices - 1));
+      pins.push_back(static_cast<Index>(value));
+    }
+  }
+  return pins;
+}
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+double signed_volume(const Vertices& V, const Faces& F) {
+  double volume = 0;
+  for (Index f = 0; f < F.rows(); ++f)
+    volume += V.row(F(f, 0)).dot(V.row(F(f, 1)).cross(V.row(F(f, 2)))) / 6.0;
+  return volume;
+}
+
+}  // namespace
+
+void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
+  auto o = std::make_shared<EnhanceOptions>();
+  CLI::App* command = app.add_subcommand("enhance", "Enhance shape features by vertex flow (Ji et al. 2011)");
+  command->add_option("IN", o->input, "Input mesh (manifold)")->required();
+  command->add_option("OUT", o->output, "Output mesh (same connectivity)")->required();
+  command->add_option("--lambda", o->flow.lambda,
+                      "Weight of the distance to the input: smaller moves vertices further (0.2 strong .. 50 faint)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  command->add_option("--mu", o->flow.mu, "Weight of the fairness term")->check(CLI::NonNegativeNumber)->capture_default_str();
+  command->add_option("--iterations", o->flow.iterations, "Solves, curvature recomputed in between")
+      ->check(CLI::Range(1, 20))
+      ->capture_default_str();
+  command->add_option("--pin", o->pin_file, "File of vertex indices (0-based) to hold in place");
+  command->add_flag("--free-boundary", o->keep_boundary_free, "Let boundary vertices move (default: fixed)");
+  command->add_option("--report", o->report_file, "Write a JSON report: options, timings per phase, metrics");
+  command->add_flag("--force", o->force, "Allow OUT to be the input file");
+  command->callback([o, &global] {
+    check_output_path(o->input, o->output, o->force);
+    if (!o->report_file.empty()) check_output_path(o->input, o->report_file, o->force, /*mesh_output=*/false);
+    auto phase = [&](const std::string& what) {
+      if (!global.quiet) fmt::print(stderr, "vertexflow: {}\n", what);
+    };
+    auto start = std::chrono::steady_clock::now();
+    phase("reading " + o->input);
+    Mesh mesh = read_mesh_with_warnings(o->input, global);
+    const double seconds_read = seconds_since(start);
+    if (!o->pin_file.empty()) o->flow.pinned = read_pins(o->pin_file, mesh.num_vertices());
+    o->flow.fix_boundary = !o->keep_boundary_free;
+
+    phase(fmt::format("flowing {} vertices (lambda {}, mu {})", mesh.num_vertices(), o->flow.lambda, o->flow.mu));
+    FlowResult result;
+    try {
+      result = vertex_flow(mesh.V, mesh.F, o->flow);
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error(o->input + ": " + e.what());
+    }
+    const FlowReport& r = result.report;
+    phase(fmt::format("curvature {:.3f} s, assembly {:.3f} s, solve {:.3f} s, guard {:.3f} s; {} vertices limited by the flip guard",
+                      r.seconds_curvature, r.seconds_assembly, r.seconds_solve, r.seconds_guard, r.limited_vertices));
+
+    Mesh out = mesh;
+    out.V = result.V;
+    start = std::chrono::steady_clock::now();
+    phase("writing " + o->output);
+    write_mesh(o->output, out);
+    const double seconds_write = seconds_since(start);
+
+    if (!o->report_file.empty()) {
+      const Topology topology = build_topology(mesh.F, mesh.num_vertices());
+      const Curvature surface = principal_curvatures(mesh.V, mesh.F, topology);
+      const Eigen::VectorXd magnitude = surface.absolute_sum();
+      const EdgeErrorStats before = edge_error_stats(mesh.V, topology, surface);
+      const EdgeErrorStats after = edge_error_stats(result.V, topology, surface);
+      const Eigen::VectorXd moved = (result.V - mesh.V).rowwise().norm() / r.mean_edge_length;
+      const double volume_before = signed_volume(mesh.V, mesh.F);
+      nlohmann::json report;
+      report["input"] = o->input;
+      report["output"] = o->output;
+      report["vertices"] = mesh.num_vertices();
+      report["faces"] = mesh.num_faces();
+      report["options"] = {{"lambda", o->flow.lambda},          {"mu", o->flow.mu},
+                           {"epsilon", o->flow.epsilon},        {"d_percentile", o->flow.d_percentile},
+                           {"iterations", o->flow.iterations},  {"fix_boundary", o->flow.fix_boundary},
+                           {"pinned", o->flow.pinned.size()}};
+      report["seconds"] = {{"read", seconds_read},           {"curvature", r.seconds_curvature},
+                           {"assembly", r.seconds_assembly}, {"solve", r.seconds_solve},
+                           {"guard", r.seconds_guard},       {"write", seconds_write}};
+      report["solver"] = {{"relative_residual", r.solver_error}, {"d", r.d}, {"mean_edge_length", r.mean_edge_length}};
+      report["guard"] = {{"faces_bad_before_guard", r.flipped_before_guard}, {"limited_vertices", r.limited_vertices},
+                         {"fixed_vertices", r.fixed_vertices}};
+      report["flipped_faces"] = flipped_faces(mesh.V, result.V, mesh.F).size();
+      report["degenerate_faces"] = degenerate_faces(result.V, mesh.F).size();
+      report["quality_input"] = to_json(summarize_quality(triangle_quality(mesh.V, mesh.F)));
+      report["quality_result"] = to_json(summarize_quality(triangle_quality(result.V, mesh.F)));
+      report["displacement_edge_lengths"] = {{"mean", moved.mean()}, {"max", moved.maxCoeff()}};
+      report["redistribution_rho"] = {{"input", redistribution_rho(magnitude, mesh.V, mesh.F)},
+                                      {"result", redistribution_rho(magnitude, result.V, mesh.F)}};
+      report["edge_error_cv"] = {{"input", before.coefficient_of_variation}, {"result", after.coefficient_of_variation}};
+      report["volume_change_percent"] =
+          volume_before != 0 ? 100.0 * (signed_volume(result.V, mesh.F) - volume_before) / std::abs(volume_before) : 0.0;
+      write_text_file(o->report_file, report.dump(2) + "\n");
+      phase("report written to " + o->report_file);
+    }
+  });
+}
+
+}  // namespace vertexflow::cli
