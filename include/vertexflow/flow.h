@@ -48,16 +48,13 @@ struct FlowOptions {
   std::vector<Index> pinned;
   /// Halvings of a vertex's displacement before it is set to zero by the flip guard.
   int max_halvings = 30;
-  /// Relative tolerance of the conjugate-gradient solve.
-  double solver_tolerance = 1e-10;
   CurvatureOptions curvature;
 };
 
 struct FlowReport {
   double mean_edge_length = 0;       ///< of the input: the unit of the normalised problem
   double d = 0;                      ///< d of Eq. 6, in input units
-  int solver_iterations = 0;         ///< conjugate-gradient iterations (sum over solves)
-  double solver_error = 0;           ///< relative residual of the last solve
+  double solver_error = 0;           ///< relative residual of the last solve's normal equations
   Index flipped_before_guard = 0;    ///< faces the unguarded solution turned or degenerated
   Index limited_vertices = 0;        ///< vertices whose displacement the guard shortened
   Index fixed_vertices = 0;          ///< boundary and pinned vertices
