@@ -10,6 +10,7 @@
 #include <Eigen/SparseCore>
 
 #include <algorithm>
+#include <dlfcn.h>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -43,6 +44,21 @@ double robust_radius(const Curvature& c, double percentile) {
   const auto rank = std::min(k.size() - 1, static_cast<std::size_t>(std::ceil(percentile / 100.0 * static_cast<double>(k.size()))) - 1);
   std::nth_element(k.begin(), k.begin() + static_cast<std::ptrdiff_t>(rank), k.end());
   return k[rank] > 0 ? 1.0 / k[rank] : 1.0;
+}
+
+// CHOLMOD's supernodal factorisation calls BLAS. Debian's default BLAS is the pthread build of
+// OpenBLAS, whose results depend on its thread count (sums in a different order) and whose
+// threads made the factorisation slower on this 2-core machine (method-notes, solver facts).
+// One BLAS thread gives the same bytes for every run; looked up at run time so that any other
+// BLAS works too.
+void use_single_threaded_blas() {
+  using SetThreads = void (*)(int);
+  for (const char* name : {"openblas_set_num_threads", "goto_set_num_threads"}) {
+    if (auto set = reinterpret_cast<SetThreads>(::dlsym(RTLD_DEFAULT, name))) {
+      set(1);
+      return;
+    }
+  }
 }
 
 // Faces that turned by more than 90 degrees or became degenerate.
@@ -98,6 +114,7 @@ Vertices solve_once(const Vertices& X, const Faces& F, const Topology& topology,
   // preconditioned iterative path planned in the flow issue.
   Eigen::VectorXd solution(free_columns);
   if (free_columns > 0) {
+    use_single_threaded_blas();
     Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> cholesky;
     cholesky.compute(normal_matrix);
     if (cholesky.info() != Eigen::Success) throw std::runtime_error("vertex flow: the normal matrix is not positive definite");

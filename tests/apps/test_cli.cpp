@@ -174,3 +174,24 @@ TEST(CliEnhance, BadPinFileAndNonManifoldInputFailCleanly) {
 
 }  // namespace
 }  // namespace vertexflow
+
+namespace vertexflow {
+namespace {
+
+TEST(CliEnhance, SameBytesWhateverTheBlasThreadCount) {
+  test::ScratchDir dir("cli-enhance-deterministic");
+  std::string outputs[2];
+  for (int threads : {1, 2}) {
+    const auto out = dir.file("out" + std::to_string(threads) + ".ply");
+    const auto r = test::run_command("OPENBLAS_NUM_THREADS=" + std::to_string(threads) + " " +
+                                     shell_quote(VERTEXFLOW_CLI) + " --quiet enhance " + data("max-planck-5k.obj") + " " +
+                                     shell_quote(out.string()));
+    ASSERT_EQ(r.exit_code, 0) << r.err;
+    outputs[threads - 1] = test::read_text(out);
+  }
+  EXPECT_FALSE(outputs[0].empty());
+  EXPECT_EQ(outputs[0], outputs[1]);
+}
+
+}  // namespace
+}  // namespace vertexflow
