@@ -4,6 +4,7 @@
 
 #include "vertexflow/colormap.h"
 #include "vertexflow/curvature.h"
+#include "vertexflow/statistics.h"
 
 #include <fmt/format.h>
 
@@ -25,15 +26,9 @@ struct CurvatureCommandOptions {
 };
 
 nlohmann::json summary(const Eigen::VectorXd& values) {
-  std::vector<double> sorted(values.data(), values.data() + values.size());
-  std::sort(sorted.begin(), sorted.end());
-  auto at = [&](double p) {
-    if (sorted.empty()) return 0.0;
-    const auto rank = static_cast<std::size_t>(std::ceil(p * static_cast<double>(sorted.size()))) - 1;
-    return sorted[std::min(rank, sorted.size() - 1)];
-  };
-  return {{"min", sorted.empty() ? 0.0 : sorted.front()}, {"p5", at(0.05)},  {"median", at(0.5)},
-          {"p95", at(0.95)}, {"max", sorted.empty() ? 0.0 : sorted.back()}, {"mean", values.size() ? values.mean() : 0.0}};
+  const std::vector<double> sample(values.data(), values.data() + values.size());
+  return {{"min", percentile(sample, 0)},    {"p5", percentile(sample, 5)},     {"median", percentile(sample, 50)},
+          {"p95", percentile(sample, 95)},   {"max", percentile(sample, 100)},  {"mean", values.size() ? values.mean() : 0.0}};
 }
 
 }  // namespace
@@ -54,13 +49,14 @@ void register_curvature_command(CLI::App& app, const GlobalOptions& global) {
     check_output_path(o->input, o->output, o->force);
     Mesh mesh = read_mesh_with_warnings(o->input, global);
     const Topology topology = build_topology(mesh.F, mesh.num_vertices());
-    if (!topology.is_manifold())
-      throw std::runtime_error(fmt::format("{}: the mesh is not manifold ({} non-manifold edges, {} non-manifold vertices)",
-                                           o->input, topology.non_manifold_edges.size(),
-                                           topology.non_manifold_vertices.size()));
     CurvatureOptions options;
     options.smoothing_rounds = o->smoothing_rounds;
-    const Curvature c = principal_curvatures(mesh.V, mesh.F, topology, options);
+    Curvature c;
+    try {
+      c = principal_curvatures(mesh.V, mesh.F, topology, options);
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error(o->input + ": " + e.what());
+    }
 
     const std::map<std::string, Eigen::VectorXd> quantities = {
         {"k1", c.k1}, {"k2", c.k2}, {"mean", c.mean()}, {"gauss", c.gaussian()}, {"abs", c.absolute_sum()}};

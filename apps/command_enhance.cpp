@@ -84,7 +84,13 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
   command->add_flag("--force", o->force, "Allow OUT to be the input file");
   command->callback([o, &global] {
     check_output_path(o->input, o->output, o->force);
-    if (!o->report_file.empty()) check_output_path(o->input, o->report_file, o->force, /*mesh_output=*/false);
+    if (!o->report_file.empty()) {
+      check_output_path(o->input, o->report_file, o->force, /*mesh_output=*/false);
+      std::error_code ec;
+      if (std::filesystem::path(o->report_file).lexically_normal() == std::filesystem::path(o->output).lexically_normal() ||
+          (std::filesystem::exists(o->report_file, ec) && std::filesystem::equivalent(o->report_file, o->output, ec)))
+        throw IoError(o->report_file + ": the report would overwrite the output mesh");
+    }
     auto phase = [&](const std::string& what) {
       if (!global.quiet) fmt::print(stderr, "vertexflow: {}\n", what);
     };
@@ -106,8 +112,12 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     phase(fmt::format("curvature {:.3f} s, assembly {:.3f} s, solve {:.3f} s, guard {:.3f} s; {} vertices limited by the flip guard",
                       r.seconds_curvature, r.seconds_assembly, r.seconds_solve, r.seconds_guard, r.limited_vertices));
 
-    Mesh out = mesh;
+    // Same connectivity and colours; per-vertex properties of the input (say, curvature from an
+    // earlier run) no longer describe the moved vertices and are not carried over.
+    Mesh out;
     out.V = result.V;
+    out.F = mesh.F;
+    out.colors = mesh.colors;
     start = std::chrono::steady_clock::now();
     phase("writing " + o->output);
     write_mesh(o->output, out);

@@ -18,8 +18,9 @@
 // - Boundary vertices get values from their one-sided neighbourhood only: finite, but biased
 //   (on hemisphere.off the boundary ring underestimates 1/R by a few percent; see
 //   tests/curvature). Vertices with no non-degenerate incident face get k1 = k2 = 0, the
-//   normal of the nearest incident face (or +z) and an arbitrary frame. No NaN or inf is ever
-//   returned for finite input.
+//   normal +z and an arbitrary frame. No NaN or inf is ever returned for finite input.
+// - Input: a manifold mesh (topology.h); principal_curvatures throws std::invalid_argument
+//   otherwise.
 #pragma once
 
 #include "vertexflow/mesh.h"

@@ -13,6 +13,10 @@
 // that would is repaired by halving the displacement of its vertices (per vertex, repeatedly,
 // like CGAL's tangential relaxation step control); FlowReport counts the vertices limited.
 // Non-manifold meshes are refused (std::invalid_argument), as topology.h states.
+//
+// Side effect: the sparse Cholesky runs with one BLAS thread, and vertex_flow sets the process's
+// OpenBLAS thread count to 1 (when OpenBLAS is the BLAS): Debian's threaded OpenBLAS made the
+// factorisation slower on 2 cores and its results depend on the thread count.
 #pragma once
 
 #include "vertexflow/curvature.h"
@@ -57,7 +61,7 @@ struct FlowReport {
   double solver_error = 0;           ///< relative residual of the last solve's normal equations
   Index flipped_before_guard = 0;    ///< faces the unguarded solution turned or degenerated
   Index limited_vertices = 0;        ///< vertices whose displacement the guard shortened
-  Index fixed_vertices = 0;          ///< boundary and pinned vertices
+  Index fixed_vertices = 0;          ///< boundary, pinned and isolated vertices
   double seconds_curvature = 0, seconds_assembly = 0, seconds_solve = 0, seconds_guard = 0;
 };
 

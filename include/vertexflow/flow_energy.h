@@ -1,9 +1,10 @@
 // The energy of the vertex flow (paper sections 3-4), term by term, and its assembly as one
 // sparse linear least-squares system.
 //
-// Notation: V = current positions (the unknowns), P = positions of the input mesh M0 (the
-// proxy of the surface), and per vertex i the input's principal curvatures k_i1, k_i2 with
-// unit directions T_i1, T_i2 and normal N_i, all frozen during a solve.
+// Notation: V = current positions (the unknowns), P = the positions the solve starts from (the
+// input mesh M0, the proxy of the surface; with several iterations, the previous result), and
+// per vertex i the principal curvatures k_i1, k_i2 of P with unit directions T_i1, T_i2 and
+// normal N_i, all frozen during a solve.
 //
 //   K_i     = |k_i1| T_i1 T_i1^T + |k_i2| T_i2 T_i2^T                        (3x3, PSD)
 //   f_em(e) = 1/2 (e_ij^T K_i e_ij + e_ji^T K_j e_ji),  e_ij = v_j - v_i      (Eq. 2-4)

@@ -68,7 +68,7 @@ struct ReadReport {
   std::int64_t duplicate_faces_removed = 0;
   std::int64_t zero_area_faces_removed = 0;
 
-  /// One human-readable line per non-zero count, e.g. "removed 3 duplicate faces".
+  /// One human-readable line per non-zero count, e.g. "3 duplicate faces removed".
   [[nodiscard]] std::vector<std::string> warnings() const;
 };
 

@@ -7,13 +7,14 @@
 //   (non_manifold_edges, non_manifold_vertices, is_oriented). One-rings are in cyclic order
 //   only at manifold vertices.
 // - Stages that need a manifold surface (curvature, flow) check `is_manifold()` and refuse
-//   non-manifold input with an error naming the offending vertices and edges; they do not
-//   silently process part of a mesh.
+//   non-manifold input with std::invalid_argument (describe_non_manifold: the counts and an
+//   offending vertex); they do not silently process part of a mesh.
 #pragma once
 
 #include "vertexflow/mesh.h"
 
 #include <cstdint>
+#include <string>
 #include <vector>
 
 namespace vertexflow {
@@ -50,8 +51,8 @@ struct Topology {
   std::vector<std::uint8_t> is_boundary_vertex;
   std::vector<std::uint8_t> is_manifold_vertex;
 
-  /// Boundary loops as vertex sequences, each following the direction of its faces' edges
-  /// reversed (so the surface lies to the left when walking with the outward normal up).
+  /// Boundary loops as vertex sequences, each running against the direction of its faces'
+  /// edges (a single counter-clockwise triangle 0, 1, 2 has the loop 0, 2, 1).
   std::vector<std::vector<Index>> boundary_loops;
 
   /// Connected components (through shared edges or vertices); isolated vertices form their own.
@@ -81,8 +82,13 @@ struct Topology {
   [[nodiscard]] Index valence(Index v) const { return ring_offsets[v + 1] - ring_offsets[v]; }
 };
 
+/// "the mesh is not manifold (E non-manifold edges, V non-manifold vertices, e.g. vertex I)",
+/// for the errors of the stages that refuse such meshes.
+std::string describe_non_manifold(const Topology& topology);
+
 /// Builds the connectivity of triangles F over `num_vertices` vertices. Indices must be in
-/// [0, num_vertices) (throws std::invalid_argument otherwise). Linear time; parallel.
+/// [0, num_vertices) and no face may repeat a vertex (read_mesh removes such faces); throws
+/// std::invalid_argument otherwise. Linear time; parallel.
 Topology build_topology(const Faces& F, Index num_vertices);
 
 }  // namespace vertexflow

@@ -9,6 +9,7 @@
 #include <Eigen/Dense>
 
 #include <cmath>
+#include <stdexcept>
 
 namespace vertexflow {
 namespace {
@@ -232,6 +233,10 @@ Curvature principal_curvatures(const Vertices& V, const Faces& F, const Topology
                                const CurvatureOptions& options) {
   const Index nv = static_cast<Index>(V.rows());
   const Index nf = static_cast<Index>(F.rows());
+  if (topology.num_vertices != nv || topology.num_faces != nf)
+    throw std::invalid_argument("principal_curvatures: the topology was built for another mesh");
+  if (!topology.is_manifold())
+    throw std::invalid_argument(describe_non_manifold(topology));
   Curvature c;
   c.k1 = Eigen::VectorXd::Zero(nv);
   c.k2 = Eigen::VectorXd::Zero(nv);

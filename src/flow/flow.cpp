@@ -3,10 +3,10 @@
 #include "vertexflow/flow.h"
 
 #include "vertexflow/flow_energy.h"
+#include "vertexflow/statistics.h"
 #include "vertexflow/topology.h"
 
 #include <Eigen/CholmodSupport>
-#include <Eigen/IterativeLinearSolvers>
 #include <Eigen/SparseCore>
 
 #include <algorithm>
@@ -37,13 +37,11 @@ double mean_edge_length(const Vertices& V, const Topology& topology) {
 }
 
 // The radius d of Eq. 6: 1 / (percentile of the largest |k| per vertex).
-double robust_radius(const Curvature& c, double percentile) {
+double robust_radius(const Curvature& c, double at_percentile) {
   std::vector<double> k(static_cast<std::size_t>(c.k1.size()));
   for (Eigen::Index i = 0; i < c.k1.size(); ++i) k[static_cast<std::size_t>(i)] = std::max(std::abs(c.k1[i]), std::abs(c.k2[i]));
-  if (k.empty()) return 1.0;
-  const auto rank = std::min(k.size() - 1, static_cast<std::size_t>(std::ceil(percentile / 100.0 * static_cast<double>(k.size()))) - 1);
-  std::nth_element(k.begin(), k.begin() + static_cast<std::ptrdiff_t>(rank), k.end());
-  return k[rank] > 0 ? 1.0 / k[rank] : 1.0;
+  const double largest = percentile(std::move(k), at_percentile);
+  return largest > 0 ? 1.0 / largest : 1.0;
 }
 
 // CHOLMOD's supernodal factorisation calls BLAS. Debian's default BLAS is the pthread build of
@@ -62,10 +60,13 @@ void use_single_threaded_blas() {
 }
 
 // Faces that turned by more than 90 degrees or became degenerate.
+// Faces already degenerate in `before` cannot be judged (no normal) and are never bad: the
+// guard could not repair them, since returning their vertices to the input restores them.
 std::vector<char> bad_faces(const Vertices& before, const Vertices& after, const Faces& F, double min_area) {
   std::vector<char> bad(static_cast<std::size_t>(F.rows()), 0);
   for (Index f = 0; f < F.rows(); ++f) {
     const Eigen::Vector3d n0 = face_normal(before, F, f), n1 = face_normal(after, F, f);
+    if (0.5 * n0.norm() < min_area) continue;
     bad[static_cast<std::size_t>(f)] = n0.dot(n1) <= 0 || 0.5 * n1.norm() < min_area;
   }
   return bad;
@@ -156,11 +157,11 @@ std::vector<Index> degenerate_faces(const Vertices& V, const Faces& F) {
 FlowResult vertex_flow(const Vertices& V, const Faces& F, const FlowOptions& options) {
   const Index n = static_cast<Index>(V.rows());
   if (n == 0 || F.rows() == 0) throw std::invalid_argument("vertex flow: the mesh is empty");
+  if (!(options.d_percentile >= 0 && options.d_percentile <= 100))
+    throw std::invalid_argument("vertex flow: d_percentile must be in [0, 100]");
+  if (options.max_halvings < 1) throw std::invalid_argument("vertex flow: max_halvings must be at least 1");
   const Topology topology = build_topology(F, n);
-  if (!topology.is_manifold())
-    throw std::invalid_argument("vertex flow: the mesh is not manifold (" + std::to_string(topology.non_manifold_edges.size()) +
-                                " non-manifold edges, " + std::to_string(topology.non_manifold_vertices.size()) +
-                                " non-manifold vertices)");
+  if (!topology.is_manifold()) throw std::invalid_argument("vertex flow: " + describe_non_manifold(topology));
   FlowResult result;
   FlowReport& report = result.report;
 
@@ -193,19 +194,25 @@ FlowResult vertex_flow(const Vertices& V, const Faces& F, const FlowOptions& opt
   std::vector<double> step(static_cast<std::size_t>(n), 1.0);
   std::vector<char> bad = bad_faces(input, X, F, min_area);
   report.flipped_before_guard = static_cast<Index>(std::count(bad.begin(), bad.end(), 1));
-  for (int halving = 0; std::count(bad.begin(), bad.end(), 1) > 0; ++halving) {
+  // Each round halves every free vertex of a bad face once; after max_halvings rounds their
+  // displacement is zero, and a face whose vertices are all back at the input is not bad.
+  std::vector<char> shortened(static_cast<std::size_t>(n), 0);
+  for (int round = 1; std::count(bad.begin(), bad.end(), 1) > 0; ++round) {
+    std::vector<char> in_bad_face(static_cast<std::size_t>(n), 0);
     for (Index f = 0; f < F.rows(); ++f) {
       if (!bad[static_cast<std::size_t>(f)]) continue;
-      for (int k = 0; k < 3; ++k) {
-        double& s = step[static_cast<std::size_t>(F(f, k))];
-        s = halving + 1 >= options.max_halvings ? 0.0 : 0.5 * s;
-      }
+      for (int k = 0; k < 3; ++k) in_bad_face[static_cast<std::size_t>(F(f, k))] = 1;
     }
-    for (Index i = 0; i < n; ++i) X.row(i) = input.row(i) + step[static_cast<std::size_t>(i)] * displacement.row(i);
+    for (Index i = 0; i < n; ++i) {
+      const auto v = static_cast<std::size_t>(i);
+      if (!in_bad_face[v] || fixed[v]) continue;
+      step[v] = round >= options.max_halvings ? 0.0 : 0.5 * step[v];
+      shortened[v] = 1;
+      X.row(i) = input.row(i) + step[v] * displacement.row(i);
+    }
     bad = bad_faces(input, X, F, min_area);
-    if (halving > options.max_halvings + 1) break;  // unreachable: all bad faces are back at the input
   }
-  report.limited_vertices = static_cast<Index>(std::count_if(step.begin(), step.end(), [](double s) { return s < 1.0; }));
+  report.limited_vertices = static_cast<Index>(std::count(shortened.begin(), shortened.end(), 1));
   report.d *= scale;
   report.seconds_guard = seconds_since(start);
 

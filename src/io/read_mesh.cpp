@@ -103,43 +103,38 @@ struct FileBytes {
   [[nodiscard]] std::string_view view() const { return {data.get(), size}; }
 };
 
+// Closes a file descriptor on every way out of a scope.
+struct FdGuard {
+  int fd;
+  ~FdGuard() {
+    if (fd >= 0) ::close(fd);
+  }
+};
+
 FileBytes read_file_bytes(const std::filesystem::path& path) {
   const std::string name = path.string();
   // O_NONBLOCK: opening a FIFO (e.g. "pipe.obj") for reading would otherwise block until a
   // writer appears; this way it opens at once and is refused below as not a regular file.
   // It has no effect on reads from regular files.
-  const int fd = ::open(name.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
-  if (fd < 0) fail(name, std::string("cannot open: ") + std::strerror(errno));
+  const FdGuard file{::open(name.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK)};
+  if (file.fd < 0) fail(name, std::string("cannot open: ") + std::strerror(errno));
   struct stat st {};
-  if (::fstat(fd, &st) != 0) {
-    const int err = errno;
-    ::close(fd);
-    fail(name, std::string("cannot stat: ") + std::strerror(err));
-  }
-  if (S_ISDIR(st.st_mode)) {
-    ::close(fd);
-    fail(name, "is a directory, not a mesh file");
-  }
-  if (!S_ISREG(st.st_mode)) {
-    ::close(fd);
-    fail(name, "is not a regular file");
-  }
+  if (::fstat(file.fd, &st) != 0) fail(name, std::string("cannot stat: ") + std::strerror(errno));
+  if (S_ISDIR(st.st_mode)) fail(name, "is a directory, not a mesh file");
+  if (!S_ISREG(st.st_mode)) fail(name, "is not a regular file");
   FileBytes bytes;
   bytes.size = static_cast<std::size_t>(st.st_size);
   bytes.data.reset(new char[std::max<std::size_t>(bytes.size, 1)]);
   std::size_t done = 0;
   while (done < bytes.size) {
-    const ssize_t n = ::read(fd, bytes.data.get() + done, bytes.size - done);
+    const ssize_t n = ::read(file.fd, bytes.data.get() + done, bytes.size - done);
     if (n < 0) {
       if (errno == EINTR) continue;
-      const int err = errno;
-      ::close(fd);
-      fail(name, std::string("read error: ") + std::strerror(err));
+      fail(name, std::string("read error: ") + std::strerror(errno));
     }
     if (n == 0) break;  // the file shrank while we read it
     done += static_cast<std::size_t>(n);
   }
-  ::close(fd);
   bytes.size = done;
   return bytes;
 }
@@ -236,6 +231,8 @@ Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& repor
   if (soup.num_polygons() == 0) fail(name, "the file contains no faces");
   if (nv64 > std::numeric_limits<Index>::max())
     fail(name, fmt::format("{} vertices exceed the supported maximum of 2^31-1", nv64));
+  if (static_cast<std::int64_t>(soup.corners.size()) > std::numeric_limits<Index>::max())
+    fail(name, fmt::format("{} face corners exceed the supported maximum of 2^31-1", soup.corners.size()));
   for (std::size_t i = 0; i < soup.xyz.size(); ++i) {
     if (!std::isfinite(soup.xyz[i]))
       fail(name, fmt::format("vertex {} has a non-finite coordinate ({})", i / 3, soup.xyz[i]));
@@ -275,12 +272,8 @@ Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& repor
     const Index* c = soup.corners.data() + soup.offsets[static_cast<std::size_t>(p)];
     const std::size_t n = static_cast<std::size_t>(soup.offsets[static_cast<std::size_t>(p) + 1] -
                                                    soup.offsets[static_cast<std::size_t>(p)]);
-    if (n == 3) {
-      if (c[0] == c[1] || c[1] == c[2] || c[2] == c[0]) {
-        ++report.repeated_index_faces_removed;
-      } else {
-        tris.insert(tris.end(), c, c + 3);
-      }
+    if (n == 3) {  // repeated indices are removed with the others after this loop
+      tris.insert(tris.end(), c, c + 3);
       continue;
     }
     // Polygon: drop consecutive repeats (including last == first) before triangulating.

@@ -220,7 +220,7 @@ class PlyParser {
     const std::uint64_t available = bytes_.size() - position();
     const std::uint64_t item = encoding_ == Encoding::Ascii ? 2 : type_size(p.type);
     if (n < 0 || static_cast<std::uint64_t>(n) > (available + 1) / item)
-      fail(name_, fmt::format("invalid list length {} for property '{}' at byte {}", n, p.name, body_));
+      fail(name_, fmt::format("invalid list length {} for property '{}' at byte {}", n, p.name, position()));
     return static_cast<std::uint64_t>(n);
   }
   void skip_property(const Property& p) {

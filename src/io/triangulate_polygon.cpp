@@ -30,7 +30,8 @@ using Cdt = CGAL::Constrained_Delaunay_triangulation_2<
     Kernel, CGAL::Triangulation_data_structure_2<VertexBase, FaceBase>, CGAL::Exact_predicates_tag>;
 
 Eigen::Vector3d point(const double* xyz, Index v) {
-  return {xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]};
+  const std::size_t i = 3 * static_cast<std::size_t>(v);
+  return {xyz[i], xyz[i + 1], xyz[i + 2]};
 }
 
 // Newell's normal: robust for non-planar and non-convex polygons (unnormalised).

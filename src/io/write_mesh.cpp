@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <cstdlib>
+#include <random>
 #include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
@@ -23,14 +24,23 @@ class AtomicFile {
  public:
   explicit AtomicFile(std::filesystem::path target) : target_(std::move(target)) {
     const std::filesystem::path dir = target_.has_parent_path() ? target_.parent_path() : ".";
-    // Hidden name beside the target, so the rename stays on one file system.
-    std::string hidden = ".";
-    hidden += target_.filename().string();
-    hidden += ".tmp-XXXXXX";
-    std::string pattern = (dir / hidden).string();
-    fd_ = ::mkstemp(pattern.data());
-    if (fd_ < 0) fail(target_.string(), std::string("cannot create a temporary file beside it: ") + std::strerror(errno));
-    temp_ = pattern;
+    // Hidden name beside the target, so the rename stays on one file system. Created with mode
+    // 0666 so the process's umask gives the file its usual permissions (mkstemp would give
+    // 0600); O_EXCL with a random suffix makes the name ours.
+    std::random_device random;
+    for (int attempt = 0; attempt < 100 && fd_ < 0; ++attempt) {
+      std::string hidden = ".";
+      hidden += target_.filename().string();
+      hidden += ".tmp-";
+      hidden += std::to_string(random());
+      temp_ = (dir / hidden).string();
+      fd_ = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+      if (fd_ < 0 && errno != EEXIST) break;
+    }
+    if (fd_ < 0) {
+      committed_ = true;  // nothing to remove
+      fail(target_.string(), std::string("cannot create a temporary file beside it: ") + std::strerror(errno));
+    }
   }
   AtomicFile(const AtomicFile&) = delete;
   AtomicFile& operator=(const AtomicFile&) = delete;
@@ -52,10 +62,7 @@ class AtomicFile {
   }
 
   void commit() {
-    // Regular permissions (mkstemp creates 0600), then data on disk before the rename.
-    const mode_t mask = ::umask(0);
-    ::umask(mask);
-    ::fchmod(fd_, 0666 & ~mask);
+    // Data on disk before the rename.
     if (::fsync(fd_) != 0) fail(target_.string(), std::string("cannot flush: ") + std::strerror(errno));
     if (::close(fd_) != 0) {
       fd_ = -1;
@@ -204,14 +211,15 @@ void write_off(Output& out, const Mesh& mesh, const WriteOptions& options) {
   }
 }
 
-void write_ply(Output& out, const Mesh& mesh, const WriteOptions& options) {
+void write_ply(Output& out, const std::string& name, const Mesh& mesh, const WriteOptions& options) {
   std::string& b = out.buffer();
   const bool colors = has_colors(mesh, options);
   std::vector<const VertexProperty*> properties;
   if (options.write_vertex_properties) {
     for (const auto& p : mesh.vertex_properties) {
       if (p.values.size() != mesh.V.rows())
-        fail("vertex property '" + p.name + "'", "has the wrong number of values for this mesh");
+        fail(name, "vertex property '" + p.name + "' has " + std::to_string(p.values.size()) + " values for " +
+                       std::to_string(mesh.V.rows()) + " vertices");
       properties.push_back(&p);
     }
   }
@@ -317,7 +325,7 @@ void write_mesh(const std::filesystem::path& path, const Mesh& mesh, const Write
   io_detail::Output out(path, is_gzip_path(path));
   switch (format) {
     case MeshFormat::Obj: io_detail::write_obj(out, mesh); break;
-    case MeshFormat::Ply: io_detail::write_ply(out, mesh, options); break;
+    case MeshFormat::Ply: io_detail::write_ply(out, name, mesh, options); break;
     case MeshFormat::Off: io_detail::write_off(out, mesh, options); break;
     case MeshFormat::Stl: io_detail::write_stl(out, mesh, options); break;
   }

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <limits>
 #include <numeric>
 #include <stdexcept>
 #include <string>
@@ -151,6 +152,15 @@ std::int64_t Topology::genus() const {
   return twice >= 0 && twice % 2 == 0 ? twice / 2 : -1;
 }
 
+std::string describe_non_manifold(const Topology& topology) {
+  std::string text = "the mesh is not manifold (" + std::to_string(topology.non_manifold_edges.size()) +
+                     " non-manifold edges, " + std::to_string(topology.non_manifold_vertices.size()) +
+                     " non-manifold vertices";
+  if (!topology.non_manifold_vertices.empty())
+    text += ", e.g. vertex " + std::to_string(topology.non_manifold_vertices.front());
+  return text + ")";
+}
+
 Topology build_topology(const Faces& F, Index num_vertices) {
   Topology t;
   t.num_vertices = num_vertices;
@@ -159,6 +169,12 @@ Topology build_topology(const Faces& F, Index num_vertices) {
   const Index nf = t.num_faces;
   if (nf > 0 && (F.minCoeff() < 0 || F.maxCoeff() >= nv))
     throw std::invalid_argument("build_topology: a face index is outside [0, " + std::to_string(nv) + ")");
+  if (static_cast<std::int64_t>(nf) * 3 > std::numeric_limits<Index>::max())
+    throw std::invalid_argument("build_topology: more than (2^31 - 1) / 3 faces");
+  for (Index f = 0; f < nf; ++f) {
+    if (F(f, 0) == F(f, 1) || F(f, 1) == F(f, 2) || F(f, 2) == F(f, 0))
+      throw std::invalid_argument("build_topology: face " + std::to_string(f) + " repeats a vertex");
+  }
 
   // Vertex -> faces (counting sort, faces in increasing order per vertex).
   {
@@ -194,14 +210,14 @@ Topology build_topology(const Faces& F, Index num_vertices) {
   std::vector<Index> scratch_neighbours(2 * t.vertex_faces.size());
   parallel_vertices(nv, [&](Index v, std::vector<Index>& scratch) {
     larger_neighbours(v, scratch);
-    std::copy(scratch.begin(), scratch.end(), scratch_neighbours.begin() + 2 * t.face_offsets[static_cast<std::size_t>(v)]);
+    std::copy(scratch.begin(), scratch.end(), scratch_neighbours.begin() + 2 * static_cast<std::ptrdiff_t>(t.face_offsets[static_cast<std::size_t>(v)]));
     edge_counts[static_cast<std::size_t>(v)] = static_cast<Index>(scratch.size());
   });
   const std::vector<Index> edge_offsets = offsets_from_counts(edge_counts);
   const Index ne = edge_offsets.back();
   t.edges.resize(ne, 2);
   parallel_vertices(nv, [&](Index v, std::vector<Index>&) {
-    const Index* source = scratch_neighbours.data() + 2 * t.face_offsets[static_cast<std::size_t>(v)];
+    const Index* source = scratch_neighbours.data() + 2 * static_cast<std::size_t>(t.face_offsets[static_cast<std::size_t>(v)]);
     Index e = edge_offsets[static_cast<std::size_t>(v)];
     for (Index i = 0; i < edge_counts[static_cast<std::size_t>(v)]; ++i, ++e) t.edges(e, 0) = v, t.edges(e, 1) = source[i];
   });

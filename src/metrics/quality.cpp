@@ -1,5 +1,7 @@
 #include "vertexflow/quality.h"
 
+#include "vertexflow/statistics.h"
+
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -31,10 +33,7 @@ QualityStats summarize_quality(const Eigen::VectorXd& quality) {
     ++s.histogram[static_cast<std::size_t>(bin)];
   }
   s.fraction_below_0_3 = static_cast<double>(below) / static_cast<double>(n);
-  std::vector<double> sorted(quality.data(), quality.data() + n);
-  const auto rank = static_cast<std::size_t>(std::ceil(0.05 * static_cast<double>(n))) - 1;
-  std::nth_element(sorted.begin(), sorted.begin() + static_cast<std::ptrdiff_t>(std::min(rank, sorted.size() - 1)), sorted.end());
-  s.p5 = sorted[std::min(rank, sorted.size() - 1)];
+  s.p5 = percentile(std::vector<double>(quality.data(), quality.data() + n), 5);
   return s;
 }
 

@@ -1,5 +1,7 @@
 #include "vertexflow/colormap.h"
 
+#include "vertexflow/statistics.h"
+
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -8,14 +10,9 @@ namespace vertexflow {
 
 double robust_color_limit(const Eigen::VectorXd& values) {
   if (values.size() == 0) return 1.0;
-  std::vector<double> sorted(values.data(), values.data() + values.size());
-  std::sort(sorted.begin(), sorted.end());
-  auto at = [&](double p) {
-    const auto rank = static_cast<std::size_t>(std::ceil(p * static_cast<double>(sorted.size()))) - 1;
-    return sorted[std::min(rank, sorted.size() - 1)];
-  };
-  double limit = std::max(std::abs(at(0.05)), std::abs(at(0.95)));
-  if (!(limit > 0)) limit = std::max(std::abs(sorted.front()), std::abs(sorted.back()));
+  const std::vector<double> sample(values.data(), values.data() + values.size());
+  double limit = std::max(std::abs(percentile(sample, 5)), std::abs(percentile(sample, 95)));
+  if (!(limit > 0)) limit = values.cwiseAbs().maxCoeff();
   return limit > 0 && std::isfinite(limit) ? limit : 1.0;
 }
 

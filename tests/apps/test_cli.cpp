@@ -193,5 +193,15 @@ TEST(CliEnhance, SameBytesWhateverTheBlasThreadCount) {
   EXPECT_EQ(outputs[0], outputs[1]);
 }
 
+TEST(CliEnhance, RefusesAReportOverTheOutput) {
+  test::ScratchDir dir("cli-enhance-report");
+  const auto out = dir.file("out.ply");
+  const auto r = run_cli("enhance " + data("spot.obj") + " " + shell_quote(out.string()) + " --report " +
+                         shell_quote(out.string()));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("the report would overwrite the output mesh"), std::string::npos) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
 }  // namespace
 }  // namespace vertexflow

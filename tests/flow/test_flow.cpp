@@ -110,5 +110,46 @@ TEST(Flow, DeterministicBetweenRuns) {
   EXPECT_EQ(vertex_flow(mesh.V, mesh.F).V, vertex_flow(mesh.V, mesh.F).V);
 }
 
+TEST(Flow, GuardCountsOnlyVerticesItShortened) {
+  // max-planck-5k has slivers the unguarded solve flips; pin every third vertex.
+  const Mesh mesh = read_mesh(test::data_path("max-planck-5k.obj"));
+  FlowOptions options;
+  for (Index v = 0; v < mesh.num_vertices(); v += 3) options.pinned.push_back(v);
+  const FlowResult result = vertex_flow(mesh.V, mesh.F, options);
+  EXPECT_TRUE(flipped_faces(mesh.V, result.V, mesh.F).empty());
+  Index moved_less = 0;
+  for (Index v = 0; v < mesh.num_vertices(); ++v) moved_less += v % 3 != 0 ? 1 : 0;
+  EXPECT_LE(result.report.limited_vertices, moved_less);
+  for (Index v = 0; v < mesh.num_vertices(); v += 3) ASSERT_EQ(result.V.row(v), mesh.V.row(v));
+}
+
+TEST(Flow, RejectsInvalidOptionsAndRepeatedVertexFaces) {
+  const Mesh mesh = read_mesh(test::data_path("spot.obj"));
+  FlowOptions options;
+  options.d_percentile = -1;
+  EXPECT_THROW(vertex_flow(mesh.V, mesh.F, options), std::invalid_argument);
+  options.d_percentile = std::nan("");
+  EXPECT_THROW(vertex_flow(mesh.V, mesh.F, options), std::invalid_argument);
+  Faces bad = mesh.F;
+  bad(0, 1) = bad(0, 0);
+  EXPECT_THROW(vertex_flow(mesh.V, bad), std::invalid_argument);
+}
+
+TEST(Flow, FacesDegenerateInTheInputDoNotStallTheGuard) {
+  // Append a zero-area face (three collinear new vertices): it cannot be judged and is left
+  // as it is, while the rest of the mesh flows.
+  Mesh mesh = read_mesh(test::data_path("spot.obj"));
+  const Index n = mesh.num_vertices();
+  mesh.V.conservativeResize(n + 3, 3);
+  mesh.V.row(n) << 5, 5, 5;
+  mesh.V.row(n + 1) << 6, 5, 5;
+  mesh.V.row(n + 2) << 7, 5, 5;
+  mesh.F.conservativeResize(mesh.F.rows() + 1, 3);
+  mesh.F.row(mesh.F.rows() - 1) << n, n + 1, n + 2;
+  const FlowResult result = vertex_flow(mesh.V, mesh.F);
+  EXPECT_EQ(result.report.flipped_before_guard, 0);
+  EXPECT_GT(mean_displacement(result.V.topRows(n), mesh.V.topRows(n)), 0.0);
+}
+
 }  // namespace
 }  // namespace vertexflow

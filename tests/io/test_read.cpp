@@ -295,5 +295,16 @@ TEST(ReadPly, AsciiRecordsMustMatchTheHeaderLineByLine) {
   }
 }
 
+TEST(Cleanup, ZeroAreaFacesCanBeKept) {
+  const std::string obj = "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 0 1 0\nf 1 2 4\nf 1 2 3\n";
+  ReadOptions keep;
+  keep.remove_zero_area_faces = false;
+  ReadReport report;
+  EXPECT_EQ(read_mesh_from_memory(obj, MeshFormat::Obj, "memory", &report, keep).num_faces(), 2);
+  EXPECT_EQ(report.zero_area_faces_removed, 0);
+  EXPECT_EQ(read_mesh_from_memory(obj, MeshFormat::Obj, "memory", &report).num_faces(), 1);
+  EXPECT_EQ(report.zero_area_faces_removed, 1);
+}
+
 }  // namespace
 }  // namespace vertexflow

@@ -80,5 +80,36 @@ TEST(CheckOutputPath, RefusesTheInputUnlessForced) {
   EXPECT_THROW(check_output_path(input, dir.file("out.unknown"), false), IoError);
 }
 
+TEST(WriteMesh, OptionsLeaveOutColoursAndProperties) {
+  test::ScratchDir dir("options");
+  Mesh mesh = triangle();
+  mesh.colors = Colors::Constant(3, 3, 200);
+  mesh.set_vertex_property("k1", Eigen::Vector3d(1, 2, 3));
+  WriteOptions options;
+  options.write_colors = false;
+  options.write_vertex_properties = false;
+  write_mesh(dir.file("plain.ply"), mesh, options);
+  const Mesh plain = read_mesh(dir.file("plain.ply"));
+  EXPECT_EQ(plain.colors.rows(), 0);
+  EXPECT_TRUE(plain.vertex_properties.empty());
+  write_mesh(dir.file("full.ply"), mesh);
+  const Mesh full = read_mesh(dir.file("full.ply"));
+  EXPECT_EQ(full.colors.rows(), 3);
+  ASSERT_NE(full.find_vertex_property("k1"), nullptr);
+}
+
+TEST(WriteMesh, PropertyErrorsNameTheFile) {
+  test::ScratchDir dir("property-error");
+  Mesh mesh = triangle();
+  mesh.vertex_properties.push_back({"short", Eigen::VectorXd::Zero(1)});
+  try {
+    write_mesh(dir.file("out.ply"), mesh);
+    FAIL();
+  } catch (const IoError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind(dir.file("out.ply").string() + ": vertex property 'short' has 1 values", 0), 0u)
+        << e.what();
+  }
+}
+
 }  // namespace
 }  // namespace vertexflow

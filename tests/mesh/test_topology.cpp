@@ -239,5 +239,10 @@ TEST(Topology, InvariantUnderVertexAndFaceReordering) {
     ASSERT_EQ(t.valence(perm[static_cast<std::size_t>(v)]), reference.valence(v));
 }
 
+TEST(Topology, RejectsFacesThatRepeatAVertex) {
+  // Such a face has no third edge; read_mesh removes them, library callers get an error.
+  EXPECT_THROW(build_topology(faces({{0, 1, 2}, {0, 0, 3}}), 4), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace vertexflow

@@ -3,6 +3,7 @@
 #include "test_support.h"
 
 #include "vertexflow/metrics.h"
+#include "vertexflow/statistics.h"
 
 #include <gtest/gtest.h>
 
@@ -50,6 +51,19 @@ TEST(EdgeError, UniformOnASphere) {
   const double cv = std::sqrt((expected.array() - expected.mean()).square().mean()) / expected.mean();
   EXPECT_NEAR(stats.coefficient_of_variation, cv, 0.02);
   EXPECT_NEAR(stats.max_over_mean, expected.maxCoeff() / expected.mean(), 0.05);
+}
+
+TEST(Percentile, NearestRank) {
+  const std::vector<double> values = {5, 1, 4, 2, 3};
+  EXPECT_EQ(percentile(values, 0), 1.0);
+  EXPECT_EQ(percentile(values, 20), 1.0);  // rank ceil(0.2 * 5) = 1
+  EXPECT_EQ(percentile(values, 21), 2.0);
+  EXPECT_EQ(percentile(values, 50), 3.0);
+  EXPECT_EQ(percentile(values, 100), 5.0);
+  EXPECT_EQ(percentile({}, 50), 0.0);
+  EXPECT_THROW(percentile(values, -0.5), std::invalid_argument);
+  EXPECT_THROW(percentile(values, 100.5), std::invalid_argument);
+  EXPECT_THROW(percentile(values, std::nan("")), std::invalid_argument);
 }
 
 }  // namespace
