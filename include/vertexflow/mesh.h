@@ -77,6 +77,9 @@ struct BoundingBox {
 /// Bounding box of V's rows.
 BoundingBox bounding_box(const Vertices& V);
 
+/// Unnormalised normal of triangle f: (v1 - v0) x (v2 - v0), length twice the area.
+Eigen::Vector3d face_normal(const Vertices& V, const Faces& F, Index f);
+
 /// Area of triangle f.
 double face_area(const Vertices& V, const Faces& F, Index f);
 

@@ -86,6 +86,9 @@ struct Topology {
 /// for the errors of the stages that refuse such meshes.
 std::string describe_non_manifold(const Topology& topology);
 
+/// Mean length of the edges of `topology` at positions V (0 without edges).
+double mean_edge_length(const Vertices& V, const Topology& topology);
+
 /// Builds the connectivity of triangles F over `num_vertices` vertices. Indices must be in
 /// [0, num_vertices) and no face may repeat a vertex (read_mesh removes such faces); throws
 /// std::invalid_argument otherwise. Linear time; parallel.

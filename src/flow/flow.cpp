@@ -24,18 +24,6 @@ double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-Eigen::Vector3d face_normal(const Vertices& V, const Faces& F, Index f) {
-  const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
-  return (b - a).cross(c - a);
-}
-
-double mean_edge_length(const Vertices& V, const Topology& topology) {
-  double sum = 0;
-  for (Index e = 0; e < topology.num_edges(); ++e)
-    sum += (V.row(topology.edges(e, 0)) - V.row(topology.edges(e, 1))).norm();
-  return topology.num_edges() > 0 ? sum / topology.num_edges() : 1.0;
-}
-
 // The radius d of Eq. 6: 1 / (percentile of the largest |k| per vertex).
 double robust_radius(const Curvature& c, double at_percentile) {
   std::vector<double> k(static_cast<std::size_t>(c.k1.size()));

@@ -272,8 +272,7 @@ void write_ply(Output& out, const std::string& name, const Mesh& mesh, const Wri
 void write_stl(Output& out, const Mesh& mesh, const WriteOptions& options) {
   std::string& b = out.buffer();
   auto normal = [&](Index f) {
-    const Eigen::Vector3d a = mesh.V.row(mesh.F(f, 0)), p = mesh.V.row(mesh.F(f, 1)), q = mesh.V.row(mesh.F(f, 2));
-    const Eigen::Vector3d n = (p - a).cross(q - a);
+    const Eigen::Vector3d n = face_normal(mesh.V, mesh.F, f);
     const double length = n.norm();
     return length > 0 ? Eigen::Vector3d(n / length) : Eigen::Vector3d::Zero();
   };

@@ -34,11 +34,13 @@ BoundingBox bounding_box(const Vertices& V) {
   return box;
 }
 
-double face_area(const Vertices& V, const Faces& F, Index f) {
+Eigen::Vector3d face_normal(const Vertices& V, const Faces& F, Index f) {
   const Eigen::Vector3d a = V.row(F(f, 0));
   const Eigen::Vector3d b = V.row(F(f, 1));
   const Eigen::Vector3d c = V.row(F(f, 2));
-  return 0.5 * (b - a).cross(c - a).norm();
+  return (b - a).cross(c - a);
 }
+
+double face_area(const Vertices& V, const Faces& F, Index f) { return 0.5 * face_normal(V, F, f).norm(); }
 
 }  // namespace vertexflow

@@ -152,6 +152,12 @@ std::int64_t Topology::genus() const {
   return twice >= 0 && twice % 2 == 0 ? twice / 2 : -1;
 }
 
+double mean_edge_length(const Vertices& V, const Topology& topology) {
+  double sum = 0;
+  for (Index e = 0; e < topology.num_edges(); ++e) sum += (V.row(topology.edges(e, 0)) - V.row(topology.edges(e, 1))).norm();
+  return topology.num_edges() > 0 ? sum / topology.num_edges() : 0.0;
+}
+
 std::string describe_non_manifold(const Topology& topology) {
   std::string text = "the mesh is not manifold (" + std::to_string(topology.non_manifold_edges.size()) +
                      " non-manifold edges, " + std::to_string(topology.non_manifold_vertices.size()) +
