@@ -25,61 +25,61 @@ void parallel_range(Index n, Body&& body) {
 
 Eigen::Vector3d position(const Vertices& V, Index v) { return V.row(v).transpose(); }
 
-// Weight of each corner's face normal in its vertex normal: the face normal n = (p1 - p0) x
-// (p2 - p0) is the cross product of the two edges at every corner, so a corner contributes
-// weight * n.
-Eigen::Vector3d corner_normal_weights(const Eigen::Vector3d p[3], const Eigen::Vector3d& n, NormalWeighting weighting) {
-  Eigen::Vector3d w = Eigen::Vector3d::Zero();
-  const double length = n.norm();
-  if (!(length > 0)) return w;
-  for (int k = 0; k < 3; ++k) {
-    const Eigen::Vector3d a = p[(k + 1) % 3] - p[k], b = p[(k + 2) % 3] - p[k];
-    switch (weighting) {
-      case NormalWeighting::Max1999: w[k] = 1.0 / (a.squaredNorm() * b.squaredNorm()); break;
-      case NormalWeighting::Area: w[k] = 1.0; break;
-      case NormalWeighting::Angle: w[k] = std::atan2(length, a.dot(b)) / length; break;
-    }
-  }
-  return w;
-}
-
-// Meyer et al. (2003) mixed areas of the three corners of one face.
-Eigen::Vector3d face_corner_areas(const Eigen::Vector3d p[3], const Eigen::Vector3d& n) {
-  const double area = 0.5 * n.norm();
-  Eigen::Vector3d result = Eigen::Vector3d::Zero();
-  if (!(area > 0)) return result;
-  double dot[3];  // dot products of the two edges at each corner (negative = obtuse)
-  for (int k = 0; k < 3; ++k) dot[k] = (p[(k + 1) % 3] - p[k]).dot(p[(k + 2) % 3] - p[k]);
-  for (int k = 0; k < 3; ++k) {
-    if (dot[k] < 0) {  // obtuse at k: half to k, a quarter to each other corner
-      result.setConstant(0.25 * area);
-      result[k] = 0.5 * area;
-      return result;
-    }
-  }
-  // Voronoi region of corner k: (|p_k p_j|^2 cot(angle at l) + |p_k p_l|^2 cot(angle at j)) / 8,
-  // with cot(angle at m) = dot[m] / (2 area).
-  for (int k = 0; k < 3; ++k) {
-    const int j = (k + 1) % 3, l = (k + 2) % 3;
-    result[k] = ((p[j] - p[k]).squaredNorm() * dot[l] + (p[l] - p[k]).squaredNorm() * dot[j]) / (16.0 * area);
-  }
-  return result;
-}
-
-// Per-face quantities computed once: the (unnormalised) face normal, each corner's weight in
-// its vertex normal, and each corner's mixed area.
+// Per-face quantities: the (unnormalised) face normal n = (p1 - p0) x (p2 - p0), each
+// corner's weight in its vertex normal (the cross product of the two edges at every corner is
+// n, so a corner contributes weight * n), and each corner's mixed area (Meyer et al. 2003).
 struct FaceGeometry {
   Eigen::Vector3d normal;
   Eigen::Vector3d normal_weight;
   Eigen::Vector3d corner_area;
 };
 
+// One pass over the face's three edge vectors d_k = p_{k+1} - p_k: at corner k the edges are
+// d_k and -d_{k+2}, so their dot product and squared lengths come from these three vectors, and
+// each weight or area needs no division of its own (this runs once per corner per vertex).
 FaceGeometry face_geometry(const Vertices& V, const Faces& F, Index f, NormalWeighting weighting) {
   const Eigen::Vector3d p[3] = {position(V, F(f, 0)), position(V, F(f, 1)), position(V, F(f, 2))};
+  const Eigen::Vector3d d[3] = {p[1] - p[0], p[2] - p[1], p[0] - p[2]};
   FaceGeometry g;
-  g.normal = (p[1] - p[0]).cross(p[2] - p[0]);
-  g.normal_weight = corner_normal_weights(p, g.normal, weighting);
-  g.corner_area = face_corner_areas(p, g.normal);
+  g.normal = d[0].cross(-d[2]);
+  g.normal_weight.setZero();
+  g.corner_area.setZero();
+  const double length = g.normal.norm();
+  if (!(length > 0)) return g;
+  const double squared[3] = {d[0].squaredNorm(), d[1].squaredNorm(), d[2].squaredNorm()};
+  double dot[3];  // of the two edges at each corner; negative = obtuse
+  for (int k = 0; k < 3; ++k) dot[k] = -d[k].dot(d[(k + 2) % 3]);
+
+  switch (weighting) {
+    case NormalWeighting::Max1999: {
+      // 1 / (|d_k|^2 |d_{k+2}|^2) = |d_{k+1}|^2 / (product of all three).
+      const double inverse = 1.0 / (squared[0] * squared[1] * squared[2]);
+      for (int k = 0; k < 3; ++k) g.normal_weight[k] = squared[(k + 1) % 3] * inverse;
+      break;
+    }
+    case NormalWeighting::Area:
+      g.normal_weight.setOnes();
+      break;
+    case NormalWeighting::Angle:
+      for (int k = 0; k < 3; ++k) g.normal_weight[k] = std::atan2(length, dot[k]) / length;
+      break;
+  }
+
+  const double area = 0.5 * length;
+  for (int k = 0; k < 3; ++k) {
+    if (dot[k] < 0) {  // obtuse at k: half to k, a quarter to each other corner
+      g.corner_area.setConstant(0.25 * area);
+      g.corner_area[k] = 0.5 * area;
+      return g;
+    }
+  }
+  // Voronoi region of corner k: (|p_k p_j|^2 cot(angle at l) + |p_k p_l|^2 cot(angle at j)) / 8
+  // with j = k + 1, l = k + 2 and cot(angle at m) = dot[m] / (2 area).
+  const double inverse = 1.0 / (16.0 * area);
+  for (int k = 0; k < 3; ++k) {
+    const int j = (k + 1) % 3, l = (k + 2) % 3;
+    g.corner_area[k] = (squared[k] * dot[l] + squared[l] * dot[j]) * inverse;
+  }
   return g;
 }
 
