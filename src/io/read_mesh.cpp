@@ -385,17 +385,20 @@ Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& repor
 
 }  // namespace io_detail
 
-bool is_gzip_path(const std::filesystem::path& path) {
+namespace {
+
+std::string lowercase_extension(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  return ext == ".gz";
+  return ext;
 }
 
+}  // namespace
+
+bool is_gzip_path(const std::filesystem::path& path) { return lowercase_extension(path) == ".gz"; }
+
 MeshFormat format_from_path(const std::filesystem::path& path) {
-  std::filesystem::path p = path;
-  if (is_gzip_path(p)) p = p.stem();
-  std::string ext = p.extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  const std::string ext = lowercase_extension(is_gzip_path(path) ? path.stem() : path);
   if (ext == ".obj") return MeshFormat::Obj;
   if (ext == ".ply") return MeshFormat::Ply;
   if (ext == ".off") return MeshFormat::Off;
