@@ -23,7 +23,9 @@ void parallel_range(Index n, Body&& body) {
   });
 }
 
-Eigen::Vector3d position(const Vertices& V, Index v) { return V.row(v).transpose(); }
+Eigen::Vector3d position(const Vertices& V, Index v) {
+  return V.row(v).transpose();
+}
 
 // Per-face quantities: the (unnormalised) face normal n = (p1 - p0) x (p2 - p0), each
 // corner's weight in its vertex normal (the cross product of the two edges at every corner is
@@ -141,22 +143,24 @@ FaceTensor fit_face_tensor(const Vertices& V, const Faces& F, const Vertices& N,
 
 // The first axis of a vertex's tangent frame (u, N x u, N): any unit vector orthogonal to N,
 // chosen from N alone so every pass derives the same frame without storing it.
-Eigen::Vector3d vertex_frame(const Eigen::Vector3d& n) { return n.unitOrthogonal(); }
+Eigen::Vector3d vertex_frame(const Eigen::Vector3d& n) {
+  return n.unitOrthogonal();
+}
 
-// Rotates x by the smallest rotation taking unit vector `from` to unit vector `to`
-// (Rodrigues: R x = x + w x x + w x (w x x) / (1 + from.to), w = from x to).
-Eigen::Vector3d rotate_between(const Eigen::Vector3d& x, const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
-  const Eigen::Vector3d w = from.cross(to);
-  const double c = from.dot(to);
-  const Eigen::Vector3d wx = w.cross(x);
-  return x + wx + w.cross(wx) * (1.0 / (1.0 + c));
+// Rotates a vector x tangent to unit `from` (x . from = 0) by the smallest rotation taking
+// `from` to unit `to`. Rodrigues' R x = x + w x x + w x (w x x) / (1 + c), with w = from x to and
+// c = from . to, reduces for such x to x - (to . x) (from + to) / (1 + c): one dot product
+// instead of three cross products (this runs once per corner).
+inline Eigen::Vector3d rotate_tangent(const Eigen::Vector3d& x, const Eigen::Vector3d& from,
+                                      const Eigen::Vector3d& to) {
+  return x - (to.dot(x) / (1.0 + from.dot(to))) * (from + to);
 }
 
 // The symmetric tensor (ku, kuv, kv) in the vertex frame (u, w = N x u) of a tensor
 // [[e, f], [f, g]] given in the frame (t, N x t) of the same tangent plane. With
 // cos(phi) = u.t and sin(phi) = w.t, the frame change is a plane rotation by phi.
-Eigen::Vector3d tensor_in_frame(double e, double f, double g, const Eigen::Vector3d& t, const Eigen::Vector3d& u,
-                                const Eigen::Vector3d& w) {
+inline Eigen::Vector3d tensor_in_frame(double e, double f, double g, const Eigen::Vector3d& t, const Eigen::Vector3d& u,
+                                       const Eigen::Vector3d& w) {
   const double c = u.dot(t), s = w.dot(t);
   // u = c t - s b and w = s t + c b, where b = N x t.
   const double u1 = c, v1 = -s, u2 = s, v2 = c;
@@ -235,8 +239,7 @@ Curvature principal_curvatures(const Vertices& V, const Faces& F, const Topology
   const Index nf = static_cast<Index>(F.rows());
   if (topology.num_vertices != nv || topology.num_faces != nf)
     throw std::invalid_argument("principal_curvatures: the topology was built for another mesh");
-  if (!topology.is_manifold())
-    throw std::invalid_argument(describe_non_manifold(topology));
+  if (!topology.is_manifold()) throw std::invalid_argument(describe_non_manifold(topology));
   Curvature c;
   c.k1 = Eigen::VectorXd::Zero(nv);
   c.k2 = Eigen::VectorXd::Zero(nv);
@@ -246,70 +249,98 @@ Curvature principal_curvatures(const Vertices& V, const Faces& F, const Topology
   c.area = Eigen::VectorXd::Zero(nv);
 
   auto corner_of = [&](Index f, Index v) { return F(f, 0) == v ? 0 : F(f, 1) == v ? 1 : 2; };
-  auto for_incident_faces = [&](Index v, auto&& body) {
-    for (Index i = topology.face_offsets[static_cast<std::size_t>(v)]; i < topology.face_offsets[static_cast<std::size_t>(v) + 1]; ++i) {
+  // The record slots of v's corners, in the topology's fixed face order (determinism).
+  auto sum_corner_records = [&](Index v, const std::vector<Eigen::Vector4d>& records) {
+    Eigen::Vector4d sum = Eigen::Vector4d::Zero();
+    const auto first = topology.face_offsets[static_cast<std::size_t>(v)];
+    const auto last = topology.face_offsets[static_cast<std::size_t>(v) + 1];
+    for (Index i = first; i < last; ++i) {
       const Index f = topology.vertex_faces[static_cast<std::size_t>(i)];
-      body(f, corner_of(f, v));
+      sum += records[3 * static_cast<std::size_t>(f) + static_cast<std::size_t>(corner_of(f, v))];
     }
+    return sum;
   };
 
-  // Pass 1, per vertex: normal and mixed area, gathered from the incident faces (each face's
-  // geometry is recomputed per corner: cheaper than storing it for every face).
-  parallel_range(nv, [&](Index v) {
-    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
-    double area = 0;
-    for_incident_faces(v, [&](Index f, int k) {
-      const FaceGeometry g = face_geometry(V, F, f, options.normal_weighting);
-      normal += g.normal_weight[k] * g.normal;
-      area += g.corner_area[k];
-    });
-    const double length = normal.norm();
-    c.N.row(v) = length > 0 ? Eigen::RowVector3d(normal.transpose() * (1.0 / length)) : Eigen::RowVector3d(0, 0, 1);
-    c.area[v] = area;
+  // One record per corner, reused by both gathers: first (weighted face normal, mixed area),
+  // then (area-weighted tensor in the vertex frame, area). Each face's geometry is computed
+  // once and each vertex sums its corners, which is cheaper than recomputing per corner and
+  // keeps the order of additions fixed.
+  std::vector<Eigen::Vector4d> corner_record(3 * static_cast<std::size_t>(nf));
+  auto record = [&](Index f, int k) -> Eigen::Vector4d& {
+    return corner_record[3 * static_cast<std::size_t>(f) + static_cast<std::size_t>(k)];
+  };
+
+  // Pass 1, per face: each corner's contribution to its vertex normal and mixed area.
+  parallel_range(nf, [&](Index f) {
+    const FaceGeometry g = face_geometry(V, F, f, options.normal_weighting);
+    for (int k = 0; k < 3; ++k) record(f, k) << g.normal_weight[k] * g.normal, g.corner_area[k];
   });
 
-  // Pass 2, per face: fit the second fundamental form (Rusinkiewicz 2004, section 3) and
-  // rotate it into the tangent frame of each of its three vertices (section 4). Each corner's
-  // record is (area-weighted tensor in the vertex frame, area).
-  std::vector<Eigen::Vector4d> corner_record(3 * static_cast<std::size_t>(nf));
+  // Pass 2, per vertex: unit normal, mixed area and the first axis of the tangent frame.
+  Vertices frame_u(nv, 3);
+  parallel_range(nv, [&](Index v) {
+    const Eigen::Vector4d sum = sum_corner_records(v, corner_record);
+    const double length = sum.head<3>().norm();
+    const Eigen::Vector3d n = length > 0 ? Eigen::Vector3d(sum.head<3>() * (1.0 / length)) : Eigen::Vector3d(0, 0, 1);
+    c.N.row(v) = n.transpose();
+    frame_u.row(v) = vertex_frame(n).transpose();
+    c.area[v] = sum[3];
+  });
+
+  // Pass 3, per face: fit the second fundamental form (Rusinkiewicz 2004, section 3) and
+  // rotate it into the tangent frame of each of its three vertices (section 4).
   parallel_range(nf, [&](Index f) {
     const FaceTensor ft = fit_face_tensor(V, F, c.N, f);
-    const FaceGeometry g = face_geometry(V, F, f, options.normal_weighting);
     for (int k = 0; k < 3; ++k) {
-      Eigen::Vector4d& record = corner_record[3 * static_cast<std::size_t>(f) + static_cast<std::size_t>(k)];
-      const Eigen::Vector3d n = c.N.row(F(f, k)).transpose();
+      Eigen::Vector4d& slot = record(f, k);
+      const double corner_area = slot[3];
+      const Index v = F(f, k);
+      const Eigen::Vector3d n = c.N.row(v).transpose();
       // Skip degenerate faces (zero area or failed fit: zero normal) and folded-over ones.
-      if (!(g.corner_area[k] > 0) || ft.n.squaredNorm() == 0 || ft.n.dot(n) <= kFoldedCosine) {
-        record.setZero();
+      if (!(corner_area > 0) || ft.n.squaredNorm() == 0 || ft.n.dot(n) <= kFoldedCosine) {
+        slot.setZero();
         continue;
       }
-      const Eigen::Vector3d u = vertex_frame(n);
-      const Eigen::Vector3d t = rotate_between(ft.t, ft.n, n);
-      record << g.corner_area[k] * tensor_in_frame(ft.e, ft.f, ft.g, t, u, n.cross(u)), g.corner_area[k];
+      const Eigen::Vector3d u = frame_u.row(v).transpose();
+      const Eigen::Vector3d t = rotate_tangent(ft.t, ft.n, n);
+      slot << corner_area * tensor_in_frame(ft.e, ft.f, ft.g, t, u, n.cross(u)), corner_area;
     }
   });
 
-  // Pass 3, per vertex: the area-weighted mean of its corners' tensors.
+  // Pass 4, per vertex: the area-weighted mean of its corners' tensors, then (unless the
+  // tensors are smoothed first) principal curvatures and directions.
   Vertices tensor = Vertices::Zero(nv, 3);
+  auto diagonalize_vertex = [&](Index v) {
+    const Eigen::Vector3d n = c.N.row(v).transpose(), u = frame_u.row(v).transpose(), w = n.cross(u);
+    double k1 = 0, k2 = 0;
+    Eigen::Vector3d t1, t2;
+    diagonalize(tensor.row(v).transpose(), u, w, n, k1, k2, t1, t2);
+    c.k1[v] = k1;
+    c.k2[v] = k2;
+    c.T1.row(v) = t1.transpose();
+    c.T2.row(v) = t2.transpose();
+  };
+  const bool smooth = options.smoothing_rounds > 0;
   parallel_range(nv, [&](Index v) {
-    Eigen::Vector4d sum = Eigen::Vector4d::Zero();
-    for_incident_faces(v, [&](Index f, int k) { sum += corner_record[3 * static_cast<std::size_t>(f) + static_cast<std::size_t>(k)]; });
+    const Eigen::Vector4d sum = sum_corner_records(v, corner_record);
     if (sum[3] > 0) tensor.row(v) = sum.head<3>().transpose() * (1.0 / sum[3]);
+    if (!smooth) diagonalize_vertex(v);
   });
   corner_record = std::vector<Eigen::Vector4d>();
+  if (!smooth) return c;
 
   // Optional smoothing: average each tensor with its neighbours', transported likewise.
   for (int round = 0; round < options.smoothing_rounds; ++round) {
     Vertices smoothed(nv, 3);
     parallel_range(nv, [&](Index v) {
-      const Eigen::Vector3d n = c.N.row(v).transpose(), u = vertex_frame(n), w = n.cross(u);
+      const Eigen::Vector3d n = c.N.row(v).transpose(), u = frame_u.row(v).transpose(), w = n.cross(u);
       Eigen::Vector3d sum = c.area[v] * tensor.row(v).transpose();
       double weight = c.area[v];
       const auto [begin, end] = topology.ring(v);
       for (const Index* j = begin; j != end; ++j) {
         const Eigen::Vector3d nj = c.N.row(*j).transpose();
         if (nj.dot(n) <= kFoldedCosine) continue;
-        const Eigen::Vector3d uj = rotate_between(vertex_frame(nj), nj, n);
+        const Eigen::Vector3d uj = rotate_tangent(frame_u.row(*j).transpose(), nj, n);
         const Eigen::Vector3d tj = tensor.row(*j).transpose();
         sum += c.area[*j] * tensor_in_frame(tj[0], tj[1], tj[2], uj, u, w);
         weight += c.area[*j];
@@ -318,18 +349,7 @@ Curvature principal_curvatures(const Vertices& V, const Faces& F, const Topology
     });
     tensor = std::move(smoothed);
   }
-
-  // Pass 4, per vertex: principal curvatures and directions.
-  parallel_range(nv, [&](Index v) {
-    const Eigen::Vector3d n = c.N.row(v).transpose(), u = vertex_frame(n), w = n.cross(u);
-    double k1 = 0, k2 = 0;
-    Eigen::Vector3d t1, t2;
-    diagonalize(tensor.row(v).transpose(), u, w, n, k1, k2, t1, t2);
-    c.k1[v] = k1;
-    c.k2[v] = k2;
-    c.T1.row(v) = t1.transpose();
-    c.T2.row(v) = t2.transpose();
-  });
+  parallel_range(nv, diagonalize_vertex);
   return c;
 }
 
