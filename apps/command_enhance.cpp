@@ -58,8 +58,7 @@ double seconds_since(std::chrono::steady_clock::time_point start) {
 
 double signed_volume(const Vertices& V, const Faces& F) {
   double volume = 0;
-  for (Index f = 0; f < F.rows(); ++f)
-    volume += V.row(F(f, 0)).dot(V.row(F(f, 1)).cross(V.row(F(f, 2)))) / 6.0;
+  for (Index f = 0; f < F.rows(); ++f) volume += V.row(F(f, 0)).dot(V.row(F(f, 1)).cross(V.row(F(f, 2)))) / 6.0;
   return volume;
 }
 
@@ -70,13 +69,21 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
   CLI::App* command = app.add_subcommand("enhance", "Enhance shape features by vertex flow (Ji et al. 2011)");
   command->add_option("IN", o->input, "Input mesh (manifold)")->required();
   command->add_option("OUT", o->output, "Output mesh (same connectivity)")->required();
-  command->add_option("--lambda", o->flow.lambda,
-                      "Weight of the distance to the input: smaller moves vertices further (0.2 strong .. 50 faint)")
+  command
+      ->add_option("--lambda", o->flow.lambda,
+                   "Weight of the distance to the input: smaller moves vertices further (0.2 strong .. 50 faint)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  command->add_option("--mu", o->flow.mu, "Weight of the fairness term")->check(CLI::NonNegativeNumber)->capture_default_str();
+  command->add_option("--mu", o->flow.mu, "Weight of the fairness term")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   command->add_option("--iterations", o->flow.iterations, "Solves, curvature recomputed in between")
       ->check(CLI::Range(1, 20))
+      ->capture_default_str();
+  command
+      ->add_option("--min-quality", o->flow.min_quality,
+                   "Guard: no face ends below min(this, its input radius ratio 2r/R); 0 repairs only flips")
+      ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   command->add_option("--pin", o->pin_file, "File of vertex indices (0-based) to hold in place");
   command->add_flag("--free-boundary", o->keep_boundary_free, "Let boundary vertices move (default: fixed)");
@@ -87,7 +94,8 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     if (!o->report_file.empty()) {
       check_output_path(o->input, o->report_file, o->force, /*mesh_output=*/false);
       std::error_code ec;
-      if (std::filesystem::path(o->report_file).lexically_normal() == std::filesystem::path(o->output).lexically_normal() ||
+      if (std::filesystem::path(o->report_file).lexically_normal() ==
+              std::filesystem::path(o->output).lexically_normal() ||
           (std::filesystem::exists(o->report_file, ec) && std::filesystem::equivalent(o->report_file, o->output, ec)))
         throw IoError(o->report_file + ": the report would overwrite the output mesh");
     }
@@ -109,8 +117,9 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
       throw std::runtime_error(o->input + ": " + e.what());
     }
     const FlowReport& r = result.report;
-    phase(fmt::format("curvature {:.3f} s, assembly {:.3f} s, solve {:.3f} s, guard {:.3f} s; {} vertices limited by the flip guard",
-                      r.seconds_curvature, r.seconds_assembly, r.seconds_solve, r.seconds_guard, r.limited_vertices));
+    phase(fmt::format(
+        "curvature {:.3f} s, assembly {:.3f} s, solve {:.3f} s, guard {:.3f} s; {} vertices limited by the guard",
+        r.seconds_curvature, r.seconds_assembly, r.seconds_solve, r.seconds_guard, r.limited_vertices));
 
     // Same connectivity and colours; per-vertex properties of the input (say, curvature from an
     // earlier run) no longer describe the moved vertices and are not carried over.
@@ -136,15 +145,17 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
       report["output"] = o->output;
       report["vertices"] = mesh.num_vertices();
       report["faces"] = mesh.num_faces();
-      report["options"] = {{"lambda", o->flow.lambda},          {"mu", o->flow.mu},
-                           {"epsilon", o->flow.epsilon},        {"d_percentile", o->flow.d_percentile},
-                           {"iterations", o->flow.iterations},  {"fix_boundary", o->flow.fix_boundary},
-                           {"pinned", o->flow.pinned.size()}};
+      report["options"] = {{"lambda", o->flow.lambda},           {"mu", o->flow.mu},
+                           {"epsilon", o->flow.epsilon},         {"d_percentile", o->flow.d_percentile},
+                           {"iterations", o->flow.iterations},   {"fix_boundary", o->flow.fix_boundary},
+                           {"min_quality", o->flow.min_quality}, {"pinned", o->flow.pinned.size()}};
       report["seconds"] = {{"read", seconds_read},           {"curvature", r.seconds_curvature},
                            {"assembly", r.seconds_assembly}, {"solve", r.seconds_solve},
                            {"guard", r.seconds_guard},       {"write", seconds_write}};
       report["solver"] = {{"relative_residual", r.solver_error}, {"d", r.d}, {"mean_edge_length", r.mean_edge_length}};
-      report["guard"] = {{"faces_bad_before_guard", r.flipped_before_guard}, {"limited_vertices", r.limited_vertices},
+      report["guard"] = {{"faces_bad_before_guard", r.flipped_before_guard},
+                         {"faces_low_quality_before_guard", r.low_quality_before_guard},
+                         {"limited_vertices", r.limited_vertices},
                          {"fixed_vertices", r.fixed_vertices}};
       report["flipped_faces"] = flipped_faces(mesh.V, result.V, mesh.F).size();
       report["degenerate_faces"] = degenerate_faces(result.V, mesh.F).size();
@@ -153,9 +164,11 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
       report["displacement_edge_lengths"] = {{"mean", moved.mean()}, {"max", moved.maxCoeff()}};
       report["redistribution_rho"] = {{"input", redistribution_rho(magnitude, mesh.V, mesh.F)},
                                       {"result", redistribution_rho(magnitude, result.V, mesh.F)}};
-      report["edge_error_cv"] = {{"input", before.coefficient_of_variation}, {"result", after.coefficient_of_variation}};
+      report["edge_error_cv"] = {{"input", before.coefficient_of_variation},
+                                 {"result", after.coefficient_of_variation}};
       report["volume_change_percent"] =
-          volume_before != 0 ? 100.0 * (signed_volume(result.V, mesh.F) - volume_before) / std::abs(volume_before) : 0.0;
+          volume_before != 0 ? 100.0 * (signed_volume(result.V, mesh.F) - volume_before) / std::abs(volume_before)
+                             : 0.0;
       write_text_file(o->report_file, report.dump(2) + "\n");
       phase("report written to " + o->report_file);
     }
