@@ -22,6 +22,7 @@ struct EnhanceOptions {
   std::string report_file;
   FlowOptions flow;
   bool keep_boundary_free = false;
+  bool no_projection = false;
   bool force = false;
 };
 
@@ -85,6 +86,20 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
                    "Guard: no face ends below min(this, its input radius ratio 2r/R); 0 repairs only flips")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
+  command->add_flag("--no-projection", o->no_projection,
+                    "Leave vertices where the solve puts them instead of moving them onto the input surface");
+  command
+      ->add_option("--fairness", o->flow.fairness_target,
+                   "Target of the fairness term: input-normal (default; keeps the shape) or zero (the paper's)")
+      ->transform(
+          CLI::CheckedTransformer(std::map<std::string, FairnessTarget>{{"input-normal", FairnessTarget::InputNormal},
+                                                                        {"zero", FairnessTarget::Zero}},
+                                  CLI::ignore_case));
+  command
+      ->add_option("--feature-angle", o->flow.feature_angle,
+                   "Dihedral angle (degrees) above which an edge is a crease vertices slide along, not across")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   command->add_option("--pin", o->pin_file, "File of vertex indices (0-based) to hold in place");
   command->add_flag("--free-boundary", o->keep_boundary_free, "Let boundary vertices move (default: fixed)");
   command->add_option("--report", o->report_file, "Write a JSON report: options, timings per phase, metrics");
@@ -108,6 +123,7 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     const double seconds_read = seconds_since(start);
     if (!o->pin_file.empty()) o->flow.pinned = read_pins(o->pin_file, mesh.num_vertices());
     o->flow.fix_boundary = !o->keep_boundary_free;
+    o->flow.project_to_input = !o->no_projection;
 
     phase(fmt::format("flowing {} vertices (lambda {}, mu {})", mesh.num_vertices(), o->flow.lambda, o->flow.mu));
     FlowResult result;
@@ -145,10 +161,18 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
       report["output"] = o->output;
       report["vertices"] = mesh.num_vertices();
       report["faces"] = mesh.num_faces();
-      report["options"] = {{"lambda", o->flow.lambda},           {"mu", o->flow.mu},
-                           {"epsilon", o->flow.epsilon},         {"d_percentile", o->flow.d_percentile},
-                           {"iterations", o->flow.iterations},   {"fix_boundary", o->flow.fix_boundary},
-                           {"min_quality", o->flow.min_quality}, {"pinned", o->flow.pinned.size()}};
+      report["options"] = {
+          {"lambda", o->flow.lambda},
+          {"mu", o->flow.mu},
+          {"epsilon", o->flow.epsilon},
+          {"d_percentile", o->flow.d_percentile},
+          {"iterations", o->flow.iterations},
+          {"fix_boundary", o->flow.fix_boundary},
+          {"min_quality", o->flow.min_quality},
+          {"pinned", o->flow.pinned.size()},
+          {"project_to_input", o->flow.project_to_input},
+          {"feature_angle", o->flow.feature_angle},
+          {"fairness_target", o->flow.fairness_target == FairnessTarget::Zero ? "zero" : "input-normal"}};
       report["seconds"] = {{"read", seconds_read},           {"curvature", r.seconds_curvature},
                            {"assembly", r.seconds_assembly}, {"solve", r.seconds_solve},
                            {"guard", r.seconds_guard},       {"write", seconds_write}};

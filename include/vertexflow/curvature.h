@@ -62,11 +62,11 @@ struct CurvatureOptions {
 
 /// Principal curvatures of every vertex. See the conventions above.
 struct Curvature {
-  Eigen::VectorXd k1;  ///< maximum principal curvature (#V)
-  Eigen::VectorXd k2;  ///< minimum principal curvature (#V), k2 <= k1
-  Vertices T1;         ///< unit direction of k1 (#V x 3)
-  Vertices T2;         ///< unit direction of k2 (#V x 3), T1 x T2 = N
-  Vertices N;          ///< unit vertex normals used for the frames (#V x 3)
+  Eigen::VectorXd k1;    ///< maximum principal curvature (#V)
+  Eigen::VectorXd k2;    ///< minimum principal curvature (#V), k2 <= k1
+  Vertices T1;           ///< unit direction of k1 (#V x 3)
+  Vertices T2;           ///< unit direction of k2 (#V x 3), T1 x T2 = N
+  Vertices N;            ///< unit vertex normals used for the frames (#V x 3)
   Eigen::VectorXd area;  ///< mixed Voronoi area per vertex (#V)
 
   [[nodiscard]] Eigen::VectorXd mean() const { return 0.5 * (k1 + k2); }

@@ -73,8 +73,7 @@ struct ReadReport {
 };
 
 /// Reads a mesh, choosing the format from the extension. Throws IoError.
-Mesh read_mesh(const std::filesystem::path& path, ReadReport* report = nullptr,
-               const ReadOptions& options = {});
+Mesh read_mesh(const std::filesystem::path& path, ReadReport* report = nullptr, const ReadOptions& options = {});
 
 /// Reads a mesh from bytes already in memory (used by the fuzzers and by read_mesh).
 /// `name` is used in error messages only. gzip data is recognised by its magic bytes.
@@ -101,8 +100,7 @@ struct WriteOptions {
 /// Writes a mesh, format chosen by extension (".gz" compresses). The file is written to a
 /// temporary file in the same directory and renamed into place, so `path` is either left as it
 /// was or holds the complete new mesh. Throws IoError.
-void write_mesh(const std::filesystem::path& path, const Mesh& mesh,
-                const WriteOptions& options = {});
+void write_mesh(const std::filesystem::path& path, const Mesh& mesh, const WriteOptions& options = {});
 
 /// Writes `text` to `path` atomically (temporary file beside it, then rename). Throws IoError.
 void write_text_file(const std::filesystem::path& path, std::string_view text);
@@ -110,7 +108,7 @@ void write_text_file(const std::filesystem::path& path, std::string_view text);
 /// Throws IoError unless `output` is safe to write while `input` is being processed: it must
 /// not be the same file as the input (unless `force`), must not be a directory and, when
 /// `mesh_output`, must have a mesh extension.
-void check_output_path(const std::filesystem::path& input, const std::filesystem::path& output,
-                       bool force, bool mesh_output = true);
+void check_output_path(const std::filesystem::path& input, const std::filesystem::path& output, bool force,
+                       bool mesh_output = true);
 
 }  // namespace vertexflow

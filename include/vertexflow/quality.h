@@ -20,8 +20,8 @@ Eigen::VectorXd triangle_quality(const Vertices& V, const Faces& F);
 struct QualityStats {
   double min = 0;
   double mean = 0;
-  double p5 = 0;                     ///< 5th percentile (nearest rank)
-  double fraction_below_0_3 = 0;     ///< share of faces with q < 0.3
+  double p5 = 0;                             ///< 5th percentile (nearest rank)
+  double fraction_below_0_3 = 0;             ///< share of faces with q < 0.3
   std::array<std::int64_t, 10> histogram{};  ///< counts in [0, 0.1), ..., [0.9, 1.0]
 };
 

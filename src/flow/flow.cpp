@@ -3,6 +3,7 @@
 #include "vertexflow/flow.h"
 
 #include "flow_solver.h"
+#include "surface_projection.h"
 #include "vertexflow/flow_energy.h"
 #include "vertexflow/quality.h"
 #include "vertexflow/statistics.h"
@@ -78,7 +79,8 @@ Vertices solve_once(const Vertices& X, const Faces& F, const Topology& topology,
   report.d = frame.d;
   report.seconds_curvature += seconds_since(start);
 
-  const Vertices Y = solve_flow_system(topology, frame, {options.lambda, options.mu, options.epsilon}, fixed, report);
+  const Vertices Y = solve_flow_system(
+      topology, frame, {options.lambda, options.mu, options.epsilon, options.fairness_target}, fixed, report);
   if (!Y.allFinite()) throw std::runtime_error("vertex flow: the solver diverged");
   return Y;
 }
@@ -109,6 +111,7 @@ FlowResult vertex_flow(const Vertices& V, const Faces& F, const FlowOptions& opt
   if (!(options.d_percentile >= 0 && options.d_percentile <= 100))
     throw std::invalid_argument("vertex flow: d_percentile must be in [0, 100]");
   if (options.max_halvings < 1) throw std::invalid_argument("vertex flow: max_halvings must be at least 1");
+  if (!(options.feature_angle >= 0)) throw std::invalid_argument("vertex flow: feature_angle must be non-negative");
   if (!(options.min_quality >= 0 && options.min_quality <= 1))
     throw std::invalid_argument("vertex flow: min_quality must be in [0, 1]");
   const Topology topology = build_topology(F, n);
@@ -127,6 +130,13 @@ FlowResult vertex_flow(const Vertices& V, const Faces& F, const FlowOptions& opt
       throw std::invalid_argument("vertex flow: pinned vertex " + std::to_string(p) + " is out of range");
     fixed[static_cast<std::size_t>(p)] = 1;
   }
+  // Sharp features (only with the projection, which is what enforces them): corners stay.
+  const SurfaceFeatures features =
+      detect_features(V, F, topology, options.project_to_input ? options.feature_angle : 180.0);
+  for (Index i = 0; i < n; ++i) {
+    if (features.vertex_kind[static_cast<std::size_t>(i)] == SurfaceFeatures::Kind::Corner)
+      fixed[static_cast<std::size_t>(i)] = 1;
+  }
   report.fixed_vertices = static_cast<Index>(std::count(fixed.begin(), fixed.end(), 1));
 
   // Normalise: centroid at the origin, mean edge length 1.
@@ -136,8 +146,14 @@ FlowResult vertex_flow(const Vertices& V, const Faces& F, const FlowOptions& opt
   const Vertices input = (V.rowwise() - centroid) / scale;
 
   Vertices X = input;
-  for (int round = 0; round < std::max(1, options.iterations); ++round)
+  for (int round = 0; round < std::max(1, options.iterations); ++round) {
     X = solve_once(X, F, topology, fixed, options, report);
+    if (options.project_to_input) {
+      const auto start = Clock::now();
+      X = project_near_vertices(X, input, F, topology, features, fixed);
+      report.seconds_projection += seconds_since(start);
+    }
+  }
 
   // Guard: halve the displacement of every vertex of a bad face until no face is bad.
   const auto start = Clock::now();
@@ -156,13 +172,17 @@ FlowResult vertex_flow(const Vertices& V, const Faces& F, const FlowOptions& opt
       if (!bad[static_cast<std::size_t>(f)]) continue;
       for (int k = 0; k < 3; ++k) in_bad_face[static_cast<std::size_t>(F(f, k))] = 1;
     }
+    std::vector<char> unchanged(static_cast<std::size_t>(n), 1);
     for (Index i = 0; i < n; ++i) {
       const auto v = static_cast<std::size_t>(i);
       if (!in_bad_face[v] || fixed[v]) continue;
       step[v] = round >= options.max_halvings ? 0.0 : 0.5 * step[v];
       shortened[v] = 1;
       X.row(i) = input.row(i) + step[v] * displacement.row(i);
+      // Back onto the surface, except at step 0: the input position itself, exactly.
+      unchanged[v] = step[v] == 0.0 || !options.project_to_input;
     }
+    X = project_near_vertices(X, input, F, topology, features, unchanged);
     bad = bad_faces(criteria, X);
   }
   report.limited_vertices = static_cast<Index>(std::count(shortened.begin(), shortened.end(), 1));

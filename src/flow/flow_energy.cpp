@@ -9,7 +9,9 @@
 namespace vertexflow {
 namespace {
 
-Eigen::Vector3d row3(const Vertices& M, Index i) { return M.row(i).transpose(); }
+Eigen::Vector3d row3(const Vertices& M, Index i) {
+  return M.row(i).transpose();
+}
 
 // K_i = |k_i1| T_i1 T_i1^T + |k_i2| T_i2 T_i2^T (Eq. 2 written as a quadratic form).
 Eigen::Matrix3d curvature_tensor(const Curvature& c, Index i) {
@@ -18,7 +20,9 @@ Eigen::Matrix3d curvature_tensor(const Curvature& c, Index i) {
 }
 
 // Eq. 10.
-double fairness_weight(const Curvature& c, Index i) { return std::exp(-(std::abs(c.k1[i]) + std::abs(c.k2[i]))); }
+double fairness_weight(const Curvature& c, Index i) {
+  return std::exp(-(std::abs(c.k1[i]) + std::abs(c.k2[i])));
+}
 
 // h_i(v) of Eq. 6.
 double squared_distance(const FlowFrame& frame, Index i, const Eigen::Vector3d& v) {
@@ -35,6 +39,13 @@ Eigen::Vector3d laplacian(const Vertices& V, const Topology& topology, Index i) 
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();
   for (const Index* j = begin; j != end; ++j) mean += row3(V, *j);
   return row3(V, i) - mean / static_cast<double>(end - begin);
+}
+
+// The umbrella vector the fairness term pulls L(v_i) towards (flow_energy.h, FairnessTarget).
+Eigen::Vector3d fairness_rest(const Topology& topology, const FlowFrame& frame, Index i, FairnessTarget target) {
+  if (target == FairnessTarget::Zero) return Eigen::Vector3d::Zero();
+  const Eigen::Vector3d n = row3(frame.curvature.N, i);
+  return laplacian(frame.P, topology, i).dot(n) * n;
 }
 
 }  // namespace
@@ -83,10 +94,11 @@ double squared_distance_energy(const Vertices& V, const FlowFrame& frame) {
   return V.rows() > 0 ? sum / static_cast<double>(V.rows()) : 0.0;
 }
 
-double fairness_energy(const Vertices& V, const Topology& topology, const FlowFrame& frame) {
+double fairness_energy(const Vertices& V, const Topology& topology, const FlowFrame& frame, FairnessTarget target) {
   double sum = 0;
   for (Index i = 0; i < static_cast<Index>(V.rows()); ++i)
-    sum += fairness_weight(frame.curvature, i) * laplacian(V, topology, i).squaredNorm();
+    sum += fairness_weight(frame.curvature, i) *
+           (laplacian(V, topology, i) - fairness_rest(topology, frame, i, target)).squaredNorm();
   return V.rows() > 0 ? sum / static_cast<double>(V.rows()) : 0.0;
 }
 
@@ -95,7 +107,8 @@ double total_flow_energy(const Vertices& V, const Topology& topology, const Flow
   const double n = static_cast<double>(V.rows());
   const double pull = n > 0 ? (V - frame.P).squaredNorm() / n : 0.0;
   return tangential_edge_energy(V, topology, frame) + weights.lambda * squared_distance_energy(V, frame) +
-         weights.mu * fairness_energy(V, topology, frame) + weights.epsilon * weights.lambda * pull;
+         weights.mu * fairness_energy(V, topology, frame, weights.fairness_target) +
+         weights.epsilon * weights.lambda * pull;
 }
 
 LeastSquaresSystem assemble_flow_system(const Topology& topology, const FlowFrame& frame,
@@ -130,7 +143,8 @@ LeastSquaresSystem assemble_flow_system(const Topology& topology, const FlowFram
     for (const Eigen::Vector3d& ta : t) {
       Eigen::RowVector3d own = Eigen::RowVector3d::Zero();
       for (const Index* j = begin; j != end; ++j) {
-        const Eigen::RowVector3d coupling = ta.transpose() * (K[static_cast<std::size_t>(i)] + K[static_cast<std::size_t>(*j)]);
+        const Eigen::RowVector3d coupling =
+            ta.transpose() * (K[static_cast<std::size_t>(i)] + K[static_cast<std::size_t>(*j)]);
         own += coupling;
         add_block_row(row, *j, -w_em * coupling);
       }
@@ -156,10 +170,11 @@ LeastSquaresSystem assemble_flow_system(const Topology& topology, const FlowFram
     if (begin != end) {
       const double w = std::sqrt(weights.mu * fairness_weight(c, i) / nv);
       const double share = w / static_cast<double>(end - begin);
+      const Eigen::Vector3d rest = fairness_rest(topology, frame, i, weights.fairness_target);
       for (int k = 0; k < 3; ++k) {
         triplets.emplace_back(row, 3 * i + k, w);
         for (const Index* j = begin; j != end; ++j) triplets.emplace_back(row, 3 * *j + k, -share);
-        rhs.push_back(0.0);
+        rhs.push_back(w * rest[k]);
         ++row;
       }
     }

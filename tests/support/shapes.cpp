@@ -1,7 +1,11 @@
 #include "shapes.h"
 
+#include "vertexflow/curvature.h"
+#include "vertexflow/topology.h"
+
 #include <cmath>
 #include <map>
+#include <random>
 #include <vector>
 
 namespace vertexflow::test {
@@ -12,7 +16,8 @@ Mesh from_lists(const std::vector<Eigen::Vector3d>& points, const std::vector<Ei
   mesh.V.resize(static_cast<Eigen::Index>(points.size()), 3);
   for (std::size_t i = 0; i < points.size(); ++i) mesh.V.row(static_cast<Eigen::Index>(i)) = points[i].transpose();
   mesh.F.resize(static_cast<Eigen::Index>(triangles.size()), 3);
-  for (std::size_t i = 0; i < triangles.size(); ++i) mesh.F.row(static_cast<Eigen::Index>(i)) = triangles[i].transpose();
+  for (std::size_t i = 0; i < triangles.size(); ++i)
+    mesh.F.row(static_cast<Eigen::Index>(i)) = triangles[i].transpose();
   return mesh;
 }
 
@@ -37,11 +42,11 @@ void grid_triangles(int rows, int cols, const auto& index, std::vector<Eigen::Ve
 
 Mesh icosphere(double radius, int levels) {
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;
-  std::vector<Eigen::Vector3d> p = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                                    {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
-  std::vector<Eigen::Vector3i> f = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
+  std::vector<Eigen::Vector3d> p = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+                                    {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
+  std::vector<Eigen::Vector3i> f = {{0, 11, 5},  {0, 5, 1},  {0, 1, 7},  {0, 7, 10}, {0, 10, 11}, {1, 5, 9}, {5, 11, 4},
                                     {11, 10, 2}, {10, 7, 6}, {7, 1, 8},  {3, 9, 4},  {3, 4, 2},   {3, 2, 6}, {3, 6, 8},
-                                    {3, 8, 9},  {4, 9, 5},   {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
+                                    {3, 8, 9},   {4, 9, 5},  {2, 4, 11}, {6, 2, 10}, {8, 6, 7},   {9, 8, 1}};
   for (auto& q : p) q.normalize();
   for (int level = 0; level < levels; ++level) {
     std::map<std::pair<int, int>, int> midpoint;
@@ -77,7 +82,8 @@ Mesh cylinder(double radius, double height, int around, int along) {
   std::vector<Eigen::Vector3i> f;
   // Rows go up in z and columns counter-clockwise about z: (i, j) -> (i, j+1) -> (i+1, j+1)
   // faces outwards.
-  grid_triangles(along, around, [&](int i, int j) { return i * around + j % around; }, f);
+  grid_triangles(
+      along, around, [&](int i, int j) { return i * around + j % around; }, f);
   for (auto& tri : f) std::swap(tri[1], tri[2]);
   return from_lists(p, f);
 }
@@ -93,7 +99,8 @@ Mesh torus(double R, double r, int around, int tube) {
     }
   }
   std::vector<Eigen::Vector3i> f;
-  grid_triangles(around, tube, [&](int i, int j) { return (i % around) * tube + j % tube; }, f);
+  grid_triangles(
+      around, tube, [&](int i, int j) { return (i % around) * tube + j % tube; }, f);
   return from_lists(p, f);
 }
 
@@ -106,8 +113,100 @@ Mesh saddle(double half, int n) {
     }
   }
   std::vector<Eigen::Vector3i> f;
-  grid_triangles(n, n, [&](int i, int j) { return i * (n + 1) + j; }, f);
+  grid_triangles(
+      n, n, [&](int i, int j) { return i * (n + 1) + j; }, f);
   return from_lists(p, f);
+}
+
+double point_triangle_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                               const Eigen::Vector3d& c) {
+  const Eigen::Vector3d ab = b - a, ac = c - a, ap = p - a;
+  const double d1 = ab.dot(ap), d2 = ac.dot(ap);
+  if (d1 <= 0 && d2 <= 0) return (p - a).norm();  // vertex region a
+  const Eigen::Vector3d bp = p - b;
+  const double d3 = ab.dot(bp), d4 = ac.dot(bp);
+  if (d3 >= 0 && d4 <= d3) return (p - b).norm();  // vertex region b
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return (p - (a + d1 / (d1 - d3) * ab)).norm();  // edge ab
+  const Eigen::Vector3d cp = p - c;
+  const double d5 = ab.dot(cp), d6 = ac.dot(cp);
+  if (d6 >= 0 && d5 <= d6) return (p - c).norm();  // vertex region c
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return (p - (a + d2 / (d2 - d6) * ac)).norm();  // edge ac
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0)
+    return (p - (b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b))).norm();  // edge bc
+  const double denominator = 1.0 / (va + vb + vc);
+  return (p - (a + ab * (vb * denominator) + ac * (vc * denominator))).norm();  // inside
+}
+
+Mesh perforated_plate(int holes, int subdivisions, double thickness, bool bottom) {
+  const int cells = 2 * holes + 1, n = cells * subdivisions;  // lattice of (n + 1)^2 points
+  std::vector<Eigen::Vector3d> p;
+  for (int layer = 0; layer < 2; ++layer) {  // 0: bottom (z = 0), 1: top (z = thickness)
+    for (int i = 0; i <= n; ++i) {
+      for (int j = 0; j <= n; ++j)
+        p.emplace_back(double(i) / subdivisions, double(j) / subdivisions, layer * thickness);
+    }
+  }
+  auto index = [&](int layer, int i, int j) { return layer * (n + 1) * (n + 1) + i * (n + 1) + j; };
+  auto solid = [&](int i, int j) {  // sub-quad (i, j) of the lattice is material
+    return i >= 0 && j >= 0 && i < n && j < n && !((i / subdivisions) % 2 == 1 && (j / subdivisions) % 2 == 1);
+  };
+  std::vector<Eigen::Vector3i> f;
+  auto quad = [&](int a, int b, int c, int d) {  // counter-clockwise seen from outside
+    f.emplace_back(a, b, c);
+    f.emplace_back(a, c, d);
+  };
+  for (int i = 0; i < n; ++i) {
+    for (int j = 0; j < n; ++j) {
+      if (!solid(i, j)) continue;
+      quad(index(1, i, j), index(1, i + 1, j), index(1, i + 1, j + 1), index(1, i, j + 1));
+      if (bottom) quad(index(0, i, j), index(0, i, j + 1), index(0, i + 1, j + 1), index(0, i + 1, j));
+      // A wall on each side whose neighbour is empty; (a -> b) runs counter-clockwise around
+      // the sub-quad seen from above, so the wall (a_bottom, b_bottom, b_top, a_top) faces out.
+      const int corner[4][2] = {{i, j}, {i + 1, j}, {i + 1, j + 1}, {i, j + 1}};
+      const int neighbour[4][2] = {{i, j - 1}, {i + 1, j}, {i, j + 1}, {i - 1, j}};
+      for (int side = 0; side < 4; ++side) {
+        if (solid(neighbour[side][0], neighbour[side][1])) continue;
+        const int* a = corner[side];
+        const int* b = corner[(side + 1) % 4];
+        quad(index(0, a[0], a[1]), index(0, b[0], b[1]), index(1, b[0], b[1]), index(1, a[0], a[1]));
+      }
+    }
+  }
+  // Drop lattice points no face uses (inside the holes), keeping the order of the others.
+  std::vector<int> remap(p.size(), -1);
+  for (const auto& t : f) {
+    for (int k = 0; k < 3; ++k) remap[static_cast<std::size_t>(t[k])] = 0;
+  }
+  std::vector<Eigen::Vector3d> used;
+  for (std::size_t v = 0; v < p.size(); ++v) {
+    if (remap[v] == 0) {
+      remap[v] = static_cast<int>(used.size());
+      used.push_back(p[v]);
+    }
+  }
+  for (auto& t : f) {
+    for (int k = 0; k < 3; ++k) t[k] = remap[static_cast<std::size_t>(t[k])];
+  }
+  return from_lists(used, f);
+}
+
+Mesh noisy_scan(const Mesh& mesh, double normal_noise, double tangential_jitter, unsigned seed) {
+  const Topology topology = build_topology(mesh.F, mesh.num_vertices());
+  const double edge = mean_edge_length(mesh.V, topology);
+  const Vertices N = vertex_normals(mesh.V, mesh.F);
+  std::mt19937 random(seed);
+  std::normal_distribution<double> gaussian(0.0, normal_noise * edge);
+  std::uniform_real_distribution<double> uniform(-tangential_jitter * edge, tangential_jitter * edge);
+  Mesh out = mesh;
+  for (Index v = 0; v < mesh.num_vertices(); ++v) {
+    const Eigen::Vector3d n = N.row(v).transpose(), t1 = n.unitOrthogonal(), t2 = n.cross(t1);
+    const double along_normal = gaussian(random), along_t1 = uniform(random), along_t2 = uniform(random);
+    out.V.row(v) += (along_normal * n + along_t1 * t1 + along_t2 * t2).transpose();
+  }
+  return out;
 }
 
 }  // namespace vertexflow::test

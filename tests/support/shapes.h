@@ -22,4 +22,23 @@ Mesh torus(double R, double r, int around, int tube);
 /// The saddle z = (x^2 - y^2) / 2 over [-half, half]^2, n x n quads; normals up (+z).
 Mesh saddle(double half, int n);
 
+/// Distance from p to the triangle (a, b, c), by Ericson's region tests ("Real-Time Collision
+/// Detection", 5.1.5): written here, independent of the library's CGAL-based queries, so tests
+/// can check those against it by brute force.
+double point_triangle_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                               const Eigen::Vector3d& c);
+
+/// A thin perforated plate, a hard case for the flow (thin walls, sharp creases, high genus):
+/// (2 holes + 1)^2 unit cells in the xy-plane, every cell with odd row and column a square
+/// through-hole, `thickness` thick in z, each cell cut into `subdivisions`^2 quads (two
+/// triangles each). With `bottom` the solid is closed with genus holes^2; without it the
+/// bottom face is left open, so each hole and the outer rim end in a boundary loop (a
+/// sheet-metal-like CAD part). Outward orientation.
+Mesh perforated_plate(int holes, int subdivisions, double thickness, bool bottom);
+
+/// A simulated noisy scan of `mesh`: every vertex displaced along its normal by Gaussian noise
+/// of `normal_noise` mean edge lengths and in the tangent plane by up to `tangential_jitter`
+/// mean edge lengths (uniform), which turns many triangles into slivers; fixed seed.
+Mesh noisy_scan(const Mesh& mesh, double normal_noise, double tangential_jitter, unsigned seed);
+
 }  // namespace vertexflow::test

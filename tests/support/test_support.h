@@ -35,9 +35,9 @@ std::string test_name(const std::string& s);
 
 /// Result of running a shell command.
 struct CommandResult {
-  int exit_code = -1;      ///< exit status, or -1 if the process died from a signal
-  std::string out;         ///< stdout
-  std::string err;         ///< stderr
+  int exit_code = -1;  ///< exit status, or -1 if the process died from a signal
+  std::string out;     ///< stdout
+  std::string err;     ///< stderr
 };
 
 /// Runs `command` through /bin/sh, capturing stdout and stderr separately.

@@ -1,0 +1,35 @@
+// Internal to the flow stage: moving points back onto the input surface, respecting its sharp
+// features.
+#pragma once
+
+#include "vertexflow/mesh.h"
+#include "vertexflow/topology.h"
+
+#include <vector>
+
+namespace vertexflow {
+
+/// Sharp features of a mesh: an interior edge is sharp when the normals of its two faces differ
+/// by more than the feature angle. Patches are the face sets connected across non-sharp edges.
+struct SurfaceFeatures {
+  enum class Kind : char { Smooth, Crease, Corner };
+  std::vector<char> sharp_edge;                  ///< per edge of the topology
+  std::vector<std::vector<Index>> vertex_sharp;  ///< sharp edges at each vertex
+  std::vector<Index> face_patch;                 ///< per face
+  std::vector<Kind> vertex_kind;                 ///< Crease: exactly two sharp edges; Corner: 1 or >= 3
+};
+
+/// Features for `angle_degrees` (>= 180 marks nothing sharp).
+SurfaceFeatures detect_features(const Vertices& V, const Faces& F, const Topology& topology, double angle_degrees);
+
+/// For each row i of `points` not marked in `skip`, a point of the surface (V, F) near it,
+/// found by a walk that starts at vertex i of (V, F): a smooth vertex walks over the faces of its
+/// own patch, from face to a closer face sharing a vertex, until none is closer; a crease
+/// vertex walks likewise along its crease's sharp edges; a corner is not moved. A walk, not a
+/// global nearest-point query, so that a point never jumps through a thin wall, and bounded by
+/// the features, so that no vertex leaves its crease or crosses one (which would cut the edge
+/// off a CAD part). Parallel over rows, deterministic.
+Vertices project_near_vertices(const Vertices& points, const Vertices& V, const Faces& F, const Topology& topology,
+                               const SurfaceFeatures& features, const std::vector<char>& skip);
+
+}  // namespace vertexflow
