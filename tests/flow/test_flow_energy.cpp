@@ -43,9 +43,12 @@ class EnergyAssembly : public ::testing::TestWithParam<int> {
  protected:
   EnergyCase make_case() const {
     switch (GetParam()) {
-      case 0: return make_setup(test::torus(2.0, 0.7, 40, 16), 0.02, 1);
-      case 1: return make_setup(read_mesh(test::data_path("fandisk.off")), 0.01, 2);
-      default: return make_setup(read_mesh(test::data_path("hemisphere.off")), 0.005, 3);
+      case 0:
+        return make_setup(test::torus(2.0, 0.7, 40, 16), 0.02, 1);
+      case 1:
+        return make_setup(read_mesh(test::data_path("fandisk.off")), 0.01, 2);
+      default:
+        return make_setup(read_mesh(test::data_path("hemisphere.off")), 0.005, 3);
     }
   }
 };
@@ -88,9 +91,43 @@ TEST_P(EnergyAssembly, EdgeGradientIsTheGradientOfTheEdgeEnergy) {
       Vertices plus = s.X, minus = s.X;
       plus(i, k) += h;
       minus(i, k) -= h;
-      const double numeric = (edge_metric_energy(plus, s.topology, s.frame) - edge_metric_energy(minus, s.topology, s.frame)) / (2 * h);
+      const double numeric =
+          (edge_metric_energy(plus, s.topology, s.frame) - edge_metric_energy(minus, s.topology, s.frame)) / (2 * h);
       EXPECT_NEAR(g(i, k) / edges, numeric, 1e-7 * (std::abs(numeric) + g.row(i).norm() / edges)) << i << " " << k;
     }
+  }
+}
+
+TEST_P(EnergyAssembly, FairnessTargetsMatchTheirFormulas) {
+  // Direct evaluation of Eq. 8-10: mu_i = exp(-(|k1| + |k2|)), L the uniform umbrella, with the
+  // paper's target (zero) and the default one (the normal part of the input's umbrella).
+  const EnergyCase s = make_case();
+  const Curvature& c = s.frame.curvature;
+  double paper = 0, ours = 0;
+  for (Index i = 0; i < s.mesh.num_vertices(); ++i) {
+    const auto [begin, end] = s.topology.ring(i);
+    Eigen::Vector3d mean_x = Eigen::Vector3d::Zero(), mean_p = Eigen::Vector3d::Zero();
+    for (const Index* j = begin; j != end; ++j) {
+      mean_x += s.X.row(*j).transpose();
+      mean_p += s.frame.P.row(*j).transpose();
+    }
+    const double degree = static_cast<double>(end - begin);
+    const Eigen::Vector3d L = s.X.row(i).transpose() - mean_x / degree;
+    const Eigen::Vector3d Lp = s.frame.P.row(i).transpose() - mean_p / degree;
+    const Eigen::Vector3d n = c.N.row(i).transpose();
+    const double mu_i = std::exp(-(std::abs(c.k1[i]) + std::abs(c.k2[i])));
+    paper += mu_i * L.squaredNorm();
+    ours += mu_i * (L - Lp.dot(n) * n).squaredNorm();
+  }
+  const double nv = static_cast<double>(s.mesh.num_vertices());
+  EXPECT_NEAR(fairness_energy(s.X, s.topology, s.frame, FairnessTarget::Zero), paper / nv, 1e-12 * paper / nv);
+  EXPECT_NEAR(fairness_energy(s.X, s.topology, s.frame, FairnessTarget::InputNormal), ours / nv, 1e-12 * paper / nv);
+  // And the assembled rows reproduce each.
+  const double only_tan = residual(assemble_flow_system(s.topology, s.frame, {0.0, 0.0, 0.0}), s.X);
+  for (const FairnessTarget target : {FairnessTarget::Zero, FairnessTarget::InputNormal}) {
+    const double assembled = residual(assemble_flow_system(s.topology, s.frame, {0.0, 1.0, 0.0, target}), s.X);
+    const double formula = target == FairnessTarget::Zero ? paper / nv : ours / nv;
+    EXPECT_NEAR(assembled - only_tan, formula, 1e-10 * (assembled + formula));
   }
 }
 
