@@ -107,6 +107,38 @@ TEST(Remesh, KeepsGenusAndComponents) {
   }
 }
 
+TEST(Remesh, SearchCorrectsTheEdgeLengthAndKeepsTheClosestRun) {
+  const Mesh fertility = read_mesh(test::data_path("fertility.off"));
+  RemeshOptions options;
+  options.target_vertices = 2000;
+  options.tolerance = 0.005;  // tighter than the first estimate: the secant steps must do it
+  const RemeshResult tight = remesh_to_vertex_count(fertility.V, fertility.F, options);
+  std::cout << "fertility -> 2000 +- 0.5 %:";
+  for (const RemeshAttempt& a : tight.report.attempts) std::cout << " " << a.vertices;
+  std::cout << "\n";
+  EXPECT_TRUE(tight.report.within_tolerance);
+  EXPECT_LE(std::abs(tight.mesh.num_vertices() - 2000), 10);
+
+  // An unreachable tolerance: every run is made and the closest one is returned.
+  options.tolerance = 0;
+  options.max_attempts = 3;
+  const RemeshResult best = remesh_to_vertex_count(fertility.V, fertility.F, options);
+  ASSERT_EQ(best.report.attempts.size(), 3u);
+  Index closest = best.report.attempts.front().vertices;
+  for (const RemeshAttempt& a : best.report.attempts)
+    if (std::abs(a.vertices - 2000) < std::abs(closest - 2000)) closest = a.vertices;
+  EXPECT_EQ(best.mesh.num_vertices(), closest);
+  EXPECT_EQ(best.report.within_tolerance, closest == 2000);
+
+  // Up-sampling: a target above the input's count.
+  const Mesh spot = read_mesh(test::data_path("spot.obj"));
+  options = {};
+  options.target_vertices = 8000;
+  const RemeshResult up = remesh_to_vertex_count(spot.V, spot.F, options);
+  EXPECT_TRUE(up.report.within_tolerance) << up.mesh.num_vertices();
+  expect_same_topology(spot, up.mesh);
+}
+
 TEST(Remesh, BoundaryIsResampledAlongTheInputBoundary) {
   const Mesh hemisphere = read_mesh(test::data_path("hemisphere.off"));
   const Topology input = build_topology(hemisphere.F, hemisphere.num_vertices());
