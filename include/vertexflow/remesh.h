@@ -39,7 +39,8 @@ struct IsotropicRemeshOptions {
 
 /// Remeshes (V, F) with target edge length `edge_length` (> 0, input units): CGAL splits edges
 /// longer than 4/3 of it and collapses those shorter than 4/5 of it. Throws
-/// std::invalid_argument for an empty, non-manifold or inconsistently oriented mesh.
+/// std::invalid_argument for an empty, non-manifold or inconsistently oriented mesh, or a
+/// length that would give more than 50 million vertices (estimated from the area).
 Mesh remesh_isotropic(const Vertices& V, const Faces& F, double edge_length,
                       const IsotropicRemeshOptions& options = {});
 
@@ -49,7 +50,7 @@ Mesh remesh_isotropic(const Vertices& V, const Faces& F, double edge_length,
 double edge_length_for_vertex_count(double area, Index vertices);
 
 struct RemeshOptions {
-  /// Vertices wanted in the result (> 0).
+  /// Vertices wanted in the result, in [3, 50 million].
   Index target_vertices = 6000;
   /// A result is accepted when |#V - target| <= tolerance * target.
   double tolerance = 0.05;

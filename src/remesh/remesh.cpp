@@ -5,6 +5,7 @@
 #include "surface_mesh_conversion.h"
 
 #include <CGAL/Polygon_mesh_processing/remesh.h>
+#include <fmt/format.h>
 
 #include <algorithm>
 #include <chrono>
@@ -52,13 +53,26 @@ double surface_area(const Vertices& V, const Faces& F) {
   return area;
 }
 
+// A too short edge length would make CGAL split until memory runs out (about 200 bytes per
+// vertex of Surface_mesh and remeshing state): refuse beyond 50 million estimated vertices.
+constexpr double kMaxVertices = 5e7;
+
+void check_vertex_estimate(double area, double edge_length) {
+  const double estimate = 2.0 * area / (std::sqrt(3.0) * edge_length * edge_length);
+  if (!(estimate <= kMaxVertices))
+    throw std::invalid_argument(fmt::format(
+        "remesh: the edge length {:g} would give about {:.3g} vertices (at most 50 million)", edge_length, estimate));
+}
+
 }  // namespace
 
 Mesh remesh_isotropic(const Vertices& V, const Faces& F, double edge_length, const IsotropicRemeshOptions& options) {
   if (!(edge_length > 0) || !std::isfinite(edge_length))
     throw std::invalid_argument("remesh: the target edge length must be positive");
   check_options(options);
-  return run(remesh_detail::to_surface_mesh(V, F, "remesh"), edge_length, options);
+  SurfaceMesh mesh = remesh_detail::to_surface_mesh(V, F, "remesh");
+  check_vertex_estimate(surface_area(V, F), edge_length);
+  return run(std::move(mesh), edge_length, options);
 }
 
 double edge_length_for_vertex_count(double area, Index vertices) {
@@ -67,7 +81,8 @@ double edge_length_for_vertex_count(double area, Index vertices) {
 
 RemeshResult remesh_to_vertex_count(const Vertices& V, const Faces& F, const RemeshOptions& options) {
   const auto start = std::chrono::steady_clock::now();
-  if (options.target_vertices < 3) throw std::invalid_argument("remesh: the target vertex count must be at least 3");
+  if (options.target_vertices < 3 || options.target_vertices > kMaxVertices)
+    throw std::invalid_argument("remesh: the target vertex count must be in [3, 50 million]");
   if (!(options.tolerance >= 0)) throw std::invalid_argument("remesh: the tolerance must not be negative");
   if (options.max_attempts < 1) throw std::invalid_argument("remesh: max_attempts must be at least 1");
   check_options(options.isotropic);
@@ -76,8 +91,10 @@ RemeshResult remesh_to_vertex_count(const Vertices& V, const Faces& F, const Rem
 
   RemeshResult best;
   double best_error = std::numeric_limits<double>::infinity();
-  double length = kLengthFactor * edge_length_for_vertex_count(surface_area(V, F), options.target_vertices);
+  const double area = surface_area(V, F);
+  double length = kLengthFactor * edge_length_for_vertex_count(area, options.target_vertices);
   for (int attempt = 0; attempt < options.max_attempts; ++attempt) {
+    check_vertex_estimate(area, length);
     const auto attempt_start = std::chrono::steady_clock::now();
     Mesh mesh = run(input, length, options.isotropic);
     const Index count = mesh.num_vertices();

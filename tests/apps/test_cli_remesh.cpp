@@ -111,6 +111,8 @@ TEST(CliRemesh, BadInputFailsCleanly) {
   expect_one_line_error(run_cli("remesh " + shell_quote(write_bowtie(dir).string()) + " " + shell_quote(out.string()) +
                                 " --target-vertices 100"),
                         "bowtie.obj: remesh: the mesh is not manifold");
+  expect_one_line_error(run_cli("remesh " + data("spot.obj") + " " + shell_quote(out.string()) + " --edge-length 1e-7"),
+                        "spot.obj: remesh: the edge length 1e-07 would give about");
   EXPECT_FALSE(std::filesystem::exists(out));
   EXPECT_NE(run_cli("remesh " + data("spot.obj") + " " + shell_quote(out.string())).exit_code, 0);
   EXPECT_NE(run_cli("remesh " + data("spot.obj") + " " + shell_quote(out.string()) + " --target-vertices 2").exit_code,

@@ -225,6 +225,12 @@ TEST(Remesh, RefusesBadInputAndOptions) {
   const Mesh sphere = test::icosphere(1.0, 2);
   EXPECT_THROW(remesh_isotropic(sphere.V, sphere.F, 0.0), std::invalid_argument);
   EXPECT_THROW(remesh_isotropic(sphere.V, sphere.F, std::nan("")), std::invalid_argument);
+  try {  // about 7e9 vertices: refused before CGAL tries
+    remesh_isotropic(sphere.V, sphere.F, 1e-4);
+    FAIL() << "runaway edge length accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("(at most 50 million)"), std::string::npos) << e.what();
+  }
   RemeshOptions options;
   options.target_vertices = 0;
   EXPECT_THROW(remesh_to_vertex_count(sphere.V, sphere.F, options), std::invalid_argument);
