@@ -5,6 +5,7 @@
 #include "vertexflow/flow.h"
 #include "vertexflow/metrics.h"
 #include "vertexflow/quality.h"
+#include "vertexflow/unsharp.h"
 
 #include <fmt/format.h>
 
@@ -21,6 +22,8 @@ struct EnhanceOptions {
   std::string pin_file;
   std::string report_file;
   FlowOptions flow;
+  std::string method = "flow";
+  UnsharpOptions unsharp;
   bool keep_boundary_free = false;
   bool no_projection = false;
   bool force = false;
@@ -63,6 +66,19 @@ double signed_volume(const Vertices& V, const Faces& F) {
   return volume;
 }
 
+// The unsharp-mask baseline (unsharp.h) in the flow's result type, so that both methods share
+// the report below. Only the fields that mean something for it are set.
+FlowResult unsharp_as_flow_result(const Mesh& mesh, const UnsharpOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  UnsharpResult unsharp = unsharp_mask(mesh.V, mesh.F, options);
+  FlowResult result;
+  result.V = std::move(unsharp.V);
+  result.report.fixed_vertices = unsharp.fixed_vertices;
+  result.report.mean_edge_length = mean_edge_length(mesh.V, build_topology(mesh.F, mesh.num_vertices()));
+  result.report.seconds_solve = seconds_since(start);
+  return result;
+}
+
 }  // namespace
 
 void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
@@ -100,11 +116,29 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
                    "Dihedral angle (degrees) above which an edge is a crease vertices slide along, not across")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  command->add_option("--method", o->method, "flow (Ji et al.) or unsharp (geometric unsharp mask baseline)")
+      ->check(CLI::IsMember({"flow", "unsharp"}))
+      ->capture_default_str();
+  CLI::Option* weight =
+      command->add_option("--weight", o->unsharp.weight, "Unsharp mask: weight w of the detail added back")
+          ->capture_default_str();
+  CLI::Option* smoothing = command
+                               ->add_option("--smoothing-iterations", o->unsharp.smoothing_iterations,
+                                            "Unsharp mask: rounds of uniform Laplacian smoothing")
+                               ->check(CLI::Range(0, 1000))
+                               ->capture_default_str();
   command->add_option("--pin", o->pin_file, "File of vertex indices (0-based) to hold in place");
   command->add_flag("--free-boundary", o->keep_boundary_free, "Let boundary vertices move (default: fixed)");
   command->add_option("--report", o->report_file, "Write a JSON report: options, timings per phase, metrics");
   command->add_flag("--force", o->force, "Allow OUT to be the input file");
-  command->callback([o, &global] {
+  command->callback([o, &global, command, weight, smoothing] {
+    const bool unsharp = o->method == "unsharp";
+    for (const char* name :
+         {"--lambda", "--mu", "--iterations", "--min-quality", "--no-projection", "--fairness", "--feature-angle"})
+      if (unsharp && command->count(name) > 0)
+        throw std::runtime_error(std::string(name) + " applies to --method flow only");
+    if (!unsharp && (weight->count() > 0 || smoothing->count() > 0))
+      throw std::runtime_error("--weight and --smoothing-iterations apply to --method unsharp only");
     check_output_path(o->input, o->output, o->force);
     if (!o->report_file.empty()) {
       check_output_path(o->input, o->report_file, o->force, /*mesh_output=*/false);
@@ -124,18 +158,25 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     if (!o->pin_file.empty()) o->flow.pinned = read_pins(o->pin_file, mesh.num_vertices());
     o->flow.fix_boundary = !o->keep_boundary_free;
     o->flow.project_to_input = !o->no_projection;
+    o->unsharp.fix_boundary = o->flow.fix_boundary;
+    o->unsharp.pinned = o->flow.pinned;
 
-    phase(fmt::format("flowing {} vertices (lambda {}, mu {})", mesh.num_vertices(), o->flow.lambda, o->flow.mu));
+    if (unsharp)
+      phase(fmt::format("unsharp mask on {} vertices (weight {}, {} smoothing iterations)", mesh.num_vertices(),
+                        o->unsharp.weight, o->unsharp.smoothing_iterations));
+    else
+      phase(fmt::format("flowing {} vertices (lambda {}, mu {})", mesh.num_vertices(), o->flow.lambda, o->flow.mu));
     FlowResult result;
     try {
-      result = vertex_flow(mesh.V, mesh.F, o->flow);
+      result = unsharp ? unsharp_as_flow_result(mesh, o->unsharp) : vertex_flow(mesh.V, mesh.F, o->flow);
     } catch (const std::invalid_argument& e) {
       throw std::runtime_error(o->input + ": " + e.what());
     }
     const FlowReport& r = result.report;
-    phase(fmt::format(
-        "curvature {:.3f} s, assembly {:.3f} s, solve {:.3f} s, guard {:.3f} s; {} vertices limited by the guard",
-        r.seconds_curvature, r.seconds_assembly, r.seconds_solve, r.seconds_guard, r.limited_vertices));
+    if (!unsharp)
+      phase(fmt::format(
+          "curvature {:.3f} s, assembly {:.3f} s, solve {:.3f} s, guard {:.3f} s; {} vertices limited by the guard",
+          r.seconds_curvature, r.seconds_assembly, r.seconds_solve, r.seconds_guard, r.limited_vertices));
 
     // Same connectivity and colours; per-vertex properties of the input (say, curvature from an
     // earlier run) no longer describe the moved vertices and are not carried over.
@@ -193,6 +234,17 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
       report["volume_change_percent"] =
           volume_before != 0 ? 100.0 * (signed_volume(result.V, mesh.F) - volume_before) / std::abs(volume_before)
                              : 0.0;
+      report["method"] = o->method;
+      if (unsharp) {  // the flow's options, solver and guard do not apply
+        report["options"] = {{"weight", o->unsharp.weight},
+                             {"smoothing_iterations", o->unsharp.smoothing_iterations},
+                             {"fix_boundary", o->unsharp.fix_boundary},
+                             {"pinned", o->unsharp.pinned.size()}};
+        report["seconds"] = {{"read", seconds_read}, {"unsharp", r.seconds_solve}, {"write", seconds_write}};
+        report.erase("solver");
+        report.erase("guard");
+        report["fixed_vertices"] = r.fixed_vertices;
+      }
       write_text_file(o->report_file, report.dump(2) + "\n");
       phase("report written to " + o->report_file);
     }

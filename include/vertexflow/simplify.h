@@ -1,0 +1,57 @@
+// Quadric-error simplification (Garland and Heckbert, "Surface simplification using quadric
+// error metrics", SIGGRAPH 1997): edges are collapsed in order of the summed squared distance of
+// the new vertex to the planes of the original faces around it, until a face budget is met.
+// The implementation is CGAL's Surface_mesh_simplification::edge_collapse with
+// GarlandHeckbert_plane_policies (cost and optimal placement); CGAL refuses collapses that
+// would change the topology or fold a face over.
+//
+// Conventions
+// - Face budget: the result has target or target + 1 faces. A collapse removes two faces (one
+//   at a free boundary edge), so an exact count is not always reachable; the collapses stop
+//   as soon as one more could go below the target. When every remaining edge is refused
+//   (topology, constraints) the result has more faces and SimplifyReport says so.
+// - keep_boundary: boundary edges are never collapsed and vertices on the boundary never move
+//   (CGAL's Constrained_placement), so every boundary loop keeps all its vertices at their exact
+//   input positions. Without it, the quadrics still penalise leaving the boundary's planes
+//   (CGAL's discontinuity multiplier, 100), but boundary vertices may merge and move.
+// - Output: vertices are the surviving input vertices in their input order (interior ones at
+//   their new optimal positions); faces keep their orientation; genus, components and boundary
+//   loops are those of the input. Colours and vertex properties are not carried over.
+// - Input: a manifold, consistently oriented triangle mesh (topology.h); anything else throws
+//   std::invalid_argument (describe_non_manifold).
+#pragma once
+
+#include "vertexflow/mesh.h"
+
+namespace vertexflow {
+
+struct SimplifyOptions {
+  /// Faces wanted in the result. 0 means: use target_ratio.
+  Index target_faces = 0;
+  /// Faces wanted as a fraction of the input's faces, in (0, 1]; used when target_faces is 0.
+  /// The budget is round(target_ratio * #F), at least 1.
+  double target_ratio = 0.1;
+  /// Keep every boundary loop exactly (see above).
+  bool keep_boundary = true;
+};
+
+struct SimplifyReport {
+  Index input_faces = 0;
+  Index target_faces = 0;  ///< the budget the collapses aimed at
+  Index output_faces = 0;
+  Index collapses = 0;          ///< edges collapsed
+  bool reached_target = false;  ///< output_faces <= target_faces + 1
+  double seconds = 0;           ///< conversion, collapses and conversion back
+};
+
+struct SimplifyResult {
+  Mesh mesh;
+  SimplifyReport report;
+};
+
+/// Simplifies (V, F) to the face budget of `options`. A budget at or above #F returns the input
+/// unchanged (apart from dropping unreferenced vertices). Throws std::invalid_argument for an
+/// empty, non-manifold or inconsistently oriented mesh, or options out of range.
+SimplifyResult simplify(const Vertices& V, const Faces& F, const SimplifyOptions& options = {});
+
+}  // namespace vertexflow

@@ -1,0 +1,51 @@
+// Geometric unsharp masking, the classical feature-enhancement baseline the vertex flow is
+// compared with: v' = v + w (v - S^k(v)), where S is uniform Laplacian smoothing (each vertex
+// replaced by the mean of its one-ring neighbours, Jacobi style) applied k times. Guskov,
+// Sweldens and Schroeder, "Multiresolution signal processing for meshes" (SIGGRAPH 1999), and
+// MeshLab's "UnSharp Mask Geometry" filter (vcglib) are the references.
+//
+// Conventions
+// - Connectivity is unchanged; only positions move. w = 0 is the identity.
+// - Fixed vertices (boundary when fix_boundary, pinned, isolated) keep their positions in the
+//   result and also during the smoothing, so they act as Dirichlet conditions for their
+//   neighbours' smoothed positions.
+// - The map is affine in V: translating, rotating or uniformly scaling the input transforms the
+//   result in the same way (no normalisation is needed, unlike the flow).
+// - Nothing limits the displacement: large w or k can fold faces (the enhance report counts
+//   flipped faces). The flow's guard is deliberately not applied, so the baseline stays the
+//   textbook filter.
+// - Differences from MeshLab's filter: MeshLab's smoothing averages each vertex with itself
+//   once and each neighbour once per shared face, and moves boundary vertices along the
+//   boundary; here S is the plain one-ring mean with fixed boundary, as in the Laplacian used
+//   by the paper's other terms. MeshLab's "original weight" is fixed at 1.
+// - Input: a manifold mesh (topology.h); std::invalid_argument otherwise, as for the flow.
+#pragma once
+
+#include "vertexflow/mesh.h"
+
+#include <vector>
+
+namespace vertexflow {
+
+struct UnsharpOptions {
+  /// w: how much of the detail v - S^k(v) is added back. MeshLab's default, 0.3.
+  double weight = 0.3;
+  /// k: rounds of uniform Laplacian smoothing that define the detail. MeshLab's default, 5.
+  int smoothing_iterations = 5;
+  /// Keep boundary vertices where they are.
+  bool fix_boundary = true;
+  /// Vertices held in place (indices into V).
+  std::vector<Index> pinned;
+};
+
+struct UnsharpResult {
+  Vertices V;                ///< new positions; faces are unchanged
+  Index fixed_vertices = 0;  ///< boundary, pinned and isolated vertices
+};
+
+/// Applies the unsharp mask to (V, F). Throws std::invalid_argument for an empty or
+/// non-manifold mesh, a negative iteration count, a non-finite weight or a pinned index out of
+/// range.
+UnsharpResult unsharp_mask(const Vertices& V, const Faces& F, const UnsharpOptions& options = {});
+
+}  // namespace vertexflow

@@ -1,0 +1,85 @@
+// Garland-Heckbert simplification through CGAL's edge-collapse framework (simplify.h).
+#include "vertexflow/simplify.h"
+
+#include "surface_mesh_conversion.h"
+
+#include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Constrained_placement.h>
+#include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/GarlandHeckbert_plane_policies.h>
+#include <CGAL/Surface_mesh_simplification/edge_collapse.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+namespace vertexflow {
+namespace {
+
+namespace SMS = CGAL::Surface_mesh_simplification;
+using remesh_detail::Kernel;
+using remesh_detail::SurfaceMesh;
+using Quadrics = SMS::GarlandHeckbert_plane_policies<SurfaceMesh, Kernel>;
+
+// Stops when one more collapse (two faces, or one at a free boundary edge) could go below the
+// budget, so the result has `target` or `target + 1` faces. CGAL 5.5 only has an edge-count
+// predicate, and the edge count of a mesh with boundary does not determine its face count.
+struct FaceBudget {
+  std::size_t target;
+  template <typename Cost, typename Profile>
+  bool operator()(const Cost& /*cost*/, const Profile& profile, std::size_t /*initial_edges*/,
+                  std::size_t /*current_edges*/) const {
+    // number_of_faces() counts live faces; BGL's num_faces() of a Surface_mesh includes removed ones.
+    return profile.surface_mesh().number_of_faces() < target + 2;
+  }
+};
+
+Index referenced_vertices(const Faces& F, Index num_vertices) {
+  std::vector<char> used(static_cast<std::size_t>(num_vertices), 0);
+  for (Index f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) used[static_cast<std::size_t>(F(f, k))] = 1;
+  return static_cast<Index>(std::count(used.begin(), used.end(), char{1}));
+}
+
+}  // namespace
+
+SimplifyResult simplify(const Vertices& V, const Faces& F, const SimplifyOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  if (options.target_faces < 0) throw std::invalid_argument("simplify: the target face count is negative");
+  if (options.target_faces == 0 && !(options.target_ratio > 0 && options.target_ratio <= 1))
+    throw std::invalid_argument("simplify: the target ratio must be in (0, 1]");
+  SurfaceMesh mesh = remesh_detail::to_surface_mesh(V, F, "simplify");
+
+  SimplifyReport report;
+  report.input_faces = static_cast<Index>(F.rows());
+  report.target_faces =
+      options.target_faces > 0
+          ? options.target_faces
+          : std::max<Index>(1, static_cast<Index>(std::lround(options.target_ratio * static_cast<double>(F.rows()))));
+  if (report.target_faces < report.input_faces) {
+    const FaceBudget stop{static_cast<std::size_t>(report.target_faces)};
+    Quadrics quadrics(mesh);
+    if (options.keep_boundary) {
+      // Boundary edges are constrained: never collapsed, and Constrained_placement puts any
+      // collapse that touches a boundary vertex onto that vertex, so the loops stay exact.
+      auto on_boundary = mesh.add_property_map<SurfaceMesh::Edge_index, bool>("e:vertexflow_boundary", false).first;
+      for (const auto e : mesh.edges()) on_boundary[e] = mesh.is_border(e);
+      const SMS::Constrained_placement<Quadrics, decltype(on_boundary)> placement(on_boundary, quadrics);
+      SMS::edge_collapse(
+          mesh, stop,
+          CGAL::parameters::edge_is_constrained_map(on_boundary).get_cost(quadrics).get_placement(placement));
+    } else {
+      SMS::edge_collapse(mesh, stop, CGAL::parameters::get_cost(quadrics).get_placement(quadrics));
+    }
+  }
+
+  SimplifyResult result{remesh_detail::from_surface_mesh(mesh), {}};
+  report.output_faces = result.mesh.num_faces();
+  // Every collapse removes exactly one vertex.
+  report.collapses = referenced_vertices(F, static_cast<Index>(V.rows())) - result.mesh.num_vertices();
+  report.reached_target = report.output_faces <= report.target_faces + 1;
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result.report = report;
+  return result;
+}
+
+}  // namespace vertexflow

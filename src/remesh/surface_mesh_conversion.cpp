@@ -1,0 +1,61 @@
+#include "surface_mesh_conversion.h"
+
+#include "vertexflow/topology.h"
+
+#include <stdexcept>
+#include <vector>
+
+namespace vertexflow::remesh_detail {
+
+SurfaceMesh to_surface_mesh(const Vertices& V, const Faces& F, const std::string& stage) {
+  if (V.rows() == 0 || F.rows() == 0) throw std::invalid_argument(stage + ": the mesh is empty");
+  // build_topology also checks the indices and repeated vertices.
+  const Topology topology = build_topology(F, static_cast<Index>(V.rows()));
+  if (!topology.is_manifold()) throw std::invalid_argument(stage + ": " + describe_non_manifold(topology));
+  if (!topology.is_oriented)
+    throw std::invalid_argument(stage + ": the faces are not consistently oriented (or the surface is not orientable)");
+
+  SurfaceMesh mesh;
+  mesh.reserve(static_cast<SurfaceMesh::size_type>(V.rows()), static_cast<SurfaceMesh::size_type>(topology.num_edges()),
+               static_cast<SurfaceMesh::size_type>(F.rows()));
+  for (Index v = 0; v < V.rows(); ++v) mesh.add_vertex(Kernel::Point_3(V(v, 0), V(v, 1), V(v, 2)));
+  for (Index f = 0; f < F.rows(); ++f) {
+    const auto face = mesh.add_face(SurfaceMesh::Vertex_index(static_cast<SurfaceMesh::size_type>(F(f, 0))),
+                                    SurfaceMesh::Vertex_index(static_cast<SurfaceMesh::size_type>(F(f, 1))),
+                                    SurfaceMesh::Vertex_index(static_cast<SurfaceMesh::size_type>(F(f, 2))));
+    // Cannot happen after the checks above; kept so that a gap in them is an error, not a hole.
+    if (face == SurfaceMesh::null_face())
+      throw std::invalid_argument(stage + ": face " + std::to_string(f) + " cannot be added to a halfedge mesh");
+  }
+  return mesh;
+}
+
+Mesh from_surface_mesh(const SurfaceMesh& mesh) {
+  // Surface_mesh iterators skip removed elements; vertex indices are renumbered densely.
+  std::vector<Index> new_index(mesh.num_vertices(), -1);
+  Index count = 0;
+  for (const auto v : mesh.vertices())
+    if (!mesh.is_isolated(v)) new_index[v.idx()] = count++;
+  Mesh out;
+  out.V.resize(count, 3);
+  for (const auto v : mesh.vertices()) {
+    const Index i = new_index[v.idx()];
+    if (i < 0) continue;
+    const auto& p = mesh.point(v);
+    out.V.row(i) << p.x(), p.y(), p.z();
+  }
+  out.F.resize(static_cast<Index>(mesh.number_of_faces()), 3);
+  Index f = 0;
+  for (const auto face : mesh.faces()) {
+    int k = 0;
+    for (const auto v : CGAL::vertices_around_face(mesh.halfedge(face), mesh)) {
+      if (k == 3) throw std::logic_error("from_surface_mesh: a face is not a triangle");
+      out.F(f, k++) = new_index[v.idx()];
+    }
+    if (k != 3) throw std::logic_error("from_surface_mesh: a face is not a triangle");
+    ++f;
+  }
+  return out;
+}
+
+}  // namespace vertexflow::remesh_detail

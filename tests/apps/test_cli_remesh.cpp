@@ -1,0 +1,177 @@
+// `vertexflow simplify`, `vertexflow remesh` and `vertexflow enhance --method unsharp` end to end:
+// outputs, JSON, one-line errors with exit code 1, no output written on failure.
+#include "test_support.h"
+
+#include "vertexflow/io.h"
+#include "vertexflow/topology.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+
+namespace vertexflow {
+namespace {
+
+using test::run_cli;
+using test::shell_quote;
+
+std::string data(const std::string& name) {
+  return shell_quote(test::data_path(name).string());
+}
+
+// One line on stderr, "vertexflow: error: ...", containing `text`; exit code 1; no output file.
+void expect_one_line_error(const test::CommandResult& r, const std::string& text) {
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_EQ(r.err.rfind("vertexflow: error: ", 0), 0u) << r.err;
+  EXPECT_NE(r.err.find(text), std::string::npos) << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+}
+
+std::filesystem::path write_bowtie(const test::ScratchDir& dir) {
+  const auto bowtie = dir.file("bowtie.obj");
+  std::ofstream(bowtie) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv -1 0 0\nv 0 -1 0\nf 1 2 3\nf 1 4 5\n";
+  return bowtie;
+}
+
+TEST(CliSimplify, WritesTheBudgetAndASummary) {
+  test::ScratchDir dir("cli-simplify");
+  const auto out = dir.file("camel.ply");
+  const auto r =
+      run_cli("simplify " + data("camelhead.off") + " " + shell_quote(out.string()) + " --faces 3000 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const Mesh result = read_mesh(out);
+  EXPECT_EQ(j["faces"], result.num_faces());
+  EXPECT_EQ(j["vertices"], result.num_vertices());
+  EXPECT_GE(result.num_faces(), 3000);
+  EXPECT_LE(result.num_faces(), 3001);
+  EXPECT_EQ(j["target_faces"], 3000);
+  EXPECT_EQ(j["keep_boundary"], true);
+  EXPECT_NE(r.err.find("simplified 22704 -> "), std::string::npos) << r.err;
+  const Topology topology = build_topology(result.F, result.num_vertices());
+  EXPECT_TRUE(topology.is_manifold());
+  EXPECT_EQ(topology.boundary_loops.size(), 1u);
+
+  const auto half = dir.file("half.off");
+  const auto ratio =
+      run_cli("--quiet simplify " + data("spot.obj") + " " + shell_quote(half.string()) + " --ratio 0.5");
+  ASSERT_EQ(ratio.exit_code, 0) << ratio.err;
+  EXPECT_TRUE(ratio.err.empty()) << ratio.err;
+  EXPECT_EQ(read_mesh(half).num_faces(), 2928);
+}
+
+TEST(CliSimplify, BadInputFailsCleanly) {
+  test::ScratchDir dir("cli-simplify-bad");
+  const auto out = dir.file("out.off");
+  expect_one_line_error(
+      run_cli("simplify " + shell_quote(write_bowtie(dir).string()) + " " + shell_quote(out.string()) + " --faces 1"),
+      "bowtie.obj: simplify: the mesh is not manifold");
+  expect_one_line_error(run_cli("simplify " + data("spot.obj") + " " + shell_quote(out.string()) + " --ratio 0"),
+                        "spot.obj: simplify: the target ratio must be in (0, 1]");
+  expect_one_line_error(run_cli("simplify /nonexistent/in.off " + shell_quote(out.string()) + " --faces 10"),
+                        "/nonexistent/in.off: ");
+  EXPECT_FALSE(std::filesystem::exists(out));
+  // A usage error: neither or both budgets.
+  EXPECT_NE(run_cli("simplify " + data("spot.obj") + " " + shell_quote(out.string())).exit_code, 0);
+  EXPECT_NE(
+      run_cli("simplify " + data("spot.obj") + " " + shell_quote(out.string()) + " --faces 10 --ratio 0.5").exit_code,
+      0);
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+TEST(CliRemesh, ReportsCountAndQuality) {
+  test::ScratchDir dir("cli-remesh");
+  const auto out = dir.file("fertility.obj");
+  const auto r =
+      run_cli("remesh " + data("fertility.off") + " " + shell_quote(out.string()) + " --target-vertices 1500 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const Mesh result = read_mesh(out);
+  EXPECT_EQ(j["vertices"], result.num_vertices());
+  EXPECT_EQ(j["within_tolerance"], true);
+  EXPECT_LE(std::abs(result.num_vertices() - 1500), 75);
+  EXPECT_GE(j["runs"].size(), 1u);
+  EXPECT_GT(j["quality"]["mean"].get<double>(), 0.85);
+  EXPECT_NE(r.err.find("-> " + std::to_string(result.num_vertices()) + " vertices"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("quality 2r/R: min"), std::string::npos) << r.err;
+  EXPECT_EQ(build_topology(result.F, result.num_vertices()).genus(), 4);
+
+  const auto fixed = dir.file("fixed.off");
+  const auto length =
+      run_cli("--quiet remesh " + data("torus.obj") + " " + shell_quote(fixed.string()) + " --edge-length 0.1");
+  ASSERT_EQ(length.exit_code, 0) << length.err;
+  EXPECT_TRUE(length.err.empty()) << length.err;
+  EXPECT_GT(read_mesh(fixed).num_vertices(), 100);
+}
+
+TEST(CliRemesh, BadInputFailsCleanly) {
+  test::ScratchDir dir("cli-remesh-bad");
+  const auto out = dir.file("out.off");
+  expect_one_line_error(run_cli("remesh " + shell_quote(write_bowtie(dir).string()) + " " + shell_quote(out.string()) +
+                                " --target-vertices 100"),
+                        "bowtie.obj: remesh: the mesh is not manifold");
+  expect_one_line_error(run_cli("remesh " + data("spot.obj") + " " + shell_quote(out.string()) + " --edge-length 1e-7"),
+                        "spot.obj: remesh: the edge length 1e-07 would give about");
+  EXPECT_FALSE(std::filesystem::exists(out));
+  EXPECT_NE(run_cli("remesh " + data("spot.obj") + " " + shell_quote(out.string())).exit_code, 0);
+  EXPECT_NE(run_cli("remesh " + data("spot.obj") + " " + shell_quote(out.string()) + " --target-vertices 2").exit_code,
+            0);
+  EXPECT_NE(run_cli("remesh " + data("spot.obj") + " " + shell_quote(out.string()) + " --edge-length -1").exit_code, 0);
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+TEST(CliEnhanceUnsharp, WritesTheMeshAndTheSameReport) {
+  test::ScratchDir dir("cli-enhance-unsharp");
+  const auto out = dir.file("head.ply");
+  const auto report = dir.file("report.json");
+  const auto pins = dir.file("pins.txt");
+  { std::ofstream(pins) << "3 77\n"; }
+  const auto r = run_cli("enhance " + data("max-planck-5k.obj") + " " + shell_quote(out.string()) +
+                         " --method unsharp --weight 0.5 --pin " + shell_quote(pins.string()) + " --report " +
+                         shell_quote(report.string()));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Mesh input = read_mesh(test::data_path("max-planck-5k.obj"));
+  const Mesh result = read_mesh(out);
+  ASSERT_EQ(result.F, input.F);
+  EXPECT_EQ(result.V.row(3), input.V.row(3));
+  EXPECT_EQ(result.V.row(77), input.V.row(77));
+  EXPECT_GT((result.V - input.V).rowwise().norm().maxCoeff(), 0.0);
+  const auto j = nlohmann::json::parse(test::read_text(report));
+  EXPECT_EQ(j["method"], "unsharp");
+  EXPECT_EQ(j["options"]["weight"], 0.5);
+  EXPECT_EQ(j["options"]["smoothing_iterations"], 5);
+  EXPECT_EQ(j["options"]["pinned"], 2);
+  // The flow's metrics, measured the same way.
+  for (const char* key : {"flipped_faces", "degenerate_faces", "quality_input", "quality_result",
+                          "displacement_edge_lengths", "redistribution_rho", "edge_error_cv", "volume_change_percent"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_FALSE(j.contains("solver"));
+  EXPECT_GT(j["displacement_edge_lengths"]["max"].get<double>(), 0.0);
+
+  // The default method is recorded as the flow.
+  const auto flow_report = dir.file("flow.json");
+  const auto flow = run_cli("--quiet enhance " + data("spot.obj") + " " + shell_quote(dir.file("spot.ply").string()) +
+                            " --report " + shell_quote(flow_report.string()));
+  ASSERT_EQ(flow.exit_code, 0) << flow.err;
+  EXPECT_EQ(nlohmann::json::parse(test::read_text(flow_report))["method"], "flow");
+}
+
+TEST(CliEnhanceUnsharp, OptionsOfTheOtherMethodAreRefused) {
+  test::ScratchDir dir("cli-enhance-unsharp-bad");
+  const auto out = dir.file("out.ply");
+  expect_one_line_error(run_cli("enhance " + data("spot.obj") + " " + shell_quote(out.string()) + " --weight 0.5"),
+                        "--weight and --smoothing-iterations apply to --method unsharp only");
+  expect_one_line_error(
+      run_cli("enhance " + data("spot.obj") + " " + shell_quote(out.string()) + " --method unsharp --lambda 2"),
+      "--lambda applies to --method flow only");
+  expect_one_line_error(run_cli("--quiet enhance " + shell_quote(write_bowtie(dir).string()) + " " +
+                                shell_quote(out.string()) + " --method unsharp"),
+                        "bowtie.obj: unsharp mask: the mesh is not manifold");
+  EXPECT_NE(run_cli("enhance " + data("spot.obj") + " " + shell_quote(out.string()) + " --method laplace").exit_code,
+            0);
+  EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+}  // namespace
+}  // namespace vertexflow

@@ -1,0 +1,194 @@
+// Garland-Heckbert simplification: the face budget, topology, exact boundaries, geometric error
+// on a sphere and on planes, refusal of meshes a halfedge structure cannot hold.
+#include "shapes.h"
+#include "test_support.h"
+
+#include "vertexflow/io.h"
+#include "vertexflow/simplify.h"
+#include "vertexflow/topology.h"
+
+#include <gtest/gtest.h>
+
+#include <array>
+#include <iostream>
+#include <set>
+
+namespace vertexflow {
+namespace {
+
+using Point = std::array<double, 3>;
+
+std::set<Point> boundary_points(const Mesh& mesh) {
+  const Topology topology = build_topology(mesh.F, mesh.num_vertices());
+  std::set<Point> points;
+  for (Index v = 0; v < mesh.num_vertices(); ++v)
+    if (topology.is_boundary_vertex[static_cast<std::size_t>(v)])
+      points.insert({mesh.V(v, 0), mesh.V(v, 1), mesh.V(v, 2)});
+  return points;
+}
+
+// Manifold, oriented, and the same genus, components and boundary loops as the input.
+void expect_same_topology(const Mesh& input, const Mesh& output) {
+  const Topology before = build_topology(input.F, input.num_vertices());
+  const Topology after = build_topology(output.F, output.num_vertices());
+  EXPECT_TRUE(after.is_manifold());
+  EXPECT_TRUE(after.is_oriented);
+  EXPECT_EQ(after.genus(), before.genus());
+  EXPECT_EQ(after.num_components, before.num_components);
+  EXPECT_EQ(after.boundary_loops.size(), before.boundary_loops.size());
+}
+
+TEST(Simplify, HitsTheFaceBudgetWithinOneFace) {
+  const Mesh spot = read_mesh(test::data_path("spot.obj"));
+  for (const Index target : {4000, 1001, 1000, 200}) {
+    SimplifyOptions options;
+    options.target_faces = target;
+    const SimplifyResult result = simplify(spot.V, spot.F, options);
+    EXPECT_GE(result.mesh.num_faces(), target);
+    EXPECT_LE(result.mesh.num_faces(), target + 1);
+    EXPECT_EQ(result.report.output_faces, result.mesh.num_faces());
+    EXPECT_EQ(result.report.input_faces, spot.num_faces());
+    EXPECT_TRUE(result.report.reached_target);
+    // A closed mesh loses one vertex and two faces per collapse.
+    EXPECT_EQ(result.report.collapses, spot.num_vertices() - result.mesh.num_vertices());
+    EXPECT_EQ(2 * result.report.collapses, spot.num_faces() - result.mesh.num_faces());
+    expect_same_topology(spot, result.mesh);
+  }
+  SimplifyOptions ratio;
+  ratio.target_ratio = 0.25;
+  const SimplifyResult quarter = simplify(spot.V, spot.F, ratio);
+  EXPECT_EQ(quarter.report.target_faces, 1464);  // round(0.25 * 5856)
+  EXPECT_LE(quarter.mesh.num_faces() - 1464, 1);
+}
+
+TEST(Simplify, KeepsGenusAndComponents) {
+  for (const char* name : {"fertility.off", "torus.obj", "suzanne.obj"}) {
+    const Mesh mesh = read_mesh(test::data_path(name));
+    SimplifyOptions options;
+    options.target_ratio = 0.2;
+    const SimplifyResult result = simplify(mesh.V, mesh.F, options);
+    SCOPED_TRACE(name);
+    expect_same_topology(mesh, result.mesh);
+    EXPECT_LE(result.mesh.num_faces(), result.report.target_faces + 1);
+  }
+}
+
+TEST(Simplify, BoundaryLoopsKeepEveryVertexExactly) {
+  for (const char* name : {"hemisphere.off", "camelhead.off"}) {
+    SCOPED_TRACE(name);
+    const Mesh mesh = read_mesh(test::data_path(name));
+    SimplifyOptions options;
+    options.target_ratio = 0.15;
+    const SimplifyResult result = simplify(mesh.V, mesh.F, options);
+    const std::set<Point> before = boundary_points(mesh);
+    EXPECT_EQ(boundary_points(result.mesh), before);  // same positions, bit for bit, none lost
+    // The interior still collapsed down to the budget.
+    EXPECT_LE(result.mesh.num_faces(), result.report.target_faces + 1);
+    expect_same_topology(mesh, result.mesh);
+  }
+}
+
+// The quadric of a sphere patch pulls the merged vertex slightly outside the sphere: for planes
+// tangent at angles phi from the vertex's direction the optimum is at R sum(cos) / sum(cos^2)
+// ~ R (1 + mean(phi^2) / 2), and phi is at most about the output's longest edge over R. Inner
+// faces cut chords, at most l^2 / (8 R) inside. So |r - R| <= l_max^2 / (2 R) with room.
+TEST(Simplify, SphereStaysCloseToTheSphere) {
+  const Mesh sphere = read_mesh(test::data_path("sphere.off"));  // unit sphere, 32k faces
+  SimplifyOptions options;
+  options.target_faces = 2000;
+  const SimplifyResult result = simplify(sphere.V, sphere.F, options);
+  const Topology topology = build_topology(result.mesh.F, result.mesh.num_vertices());
+  double longest = 0;
+  for (Index e = 0; e < topology.num_edges(); ++e)
+    longest =
+        std::max(longest, (result.mesh.V.row(topology.edges(e, 0)) - result.mesh.V.row(topology.edges(e, 1))).norm());
+  const Eigen::VectorXd radius = result.mesh.V.rowwise().norm();
+  const double deviation = (radius.array() - 1.0).abs().maxCoeff();
+  std::cout << "sphere: max radial deviation " << deviation << ", longest edge " << longest << "\n";
+  EXPECT_LT(deviation, longest * longest / 2);
+  EXPECT_LT(deviation, 0.01);  // in absolute terms: 1% of the radius
+  expect_same_topology(sphere, result.mesh);
+}
+
+// Collapses inside a plane cost nothing, so a flat square grid collapses down to (almost) the
+// fewest triangles its boundary allows. With the boundary kept (b vertices, all stay) every
+// interior vertex but at most one goes: the last one's only collapses are onto boundary
+// vertices, and a fan from a vertex of the square's sides has degenerate triangles, which CGAL
+// refuses. With a free boundary only the four corners remain: two triangles.
+TEST(Simplify, PlanesCollapseToTheirBoundaryWithoutError) {
+  Mesh grid = test::saddle(1.0, 20);
+  grid.V.col(2).setZero();
+  const Topology topology = build_topology(grid.F, grid.num_vertices());
+  const Index boundary = static_cast<Index>(topology.boundary_loops.front().size());
+  ASSERT_EQ(boundary, 80);
+  ASSERT_EQ(grid.num_vertices(), 441);
+
+  SimplifyOptions options;
+  options.target_faces = 1;
+  const SimplifyResult kept = simplify(grid.V, grid.F, options);
+  EXPECT_LE(kept.mesh.num_vertices(), boundary + 1);
+  EXPECT_EQ(boundary_points(kept.mesh), boundary_points(grid));
+  EXPECT_LE(kept.mesh.num_faces(), boundary);  // disk: F = 2 V - b - 2
+  EXPECT_FALSE(kept.report.reached_target);
+  EXPECT_EQ(kept.mesh.V.col(2).cwiseAbs().maxCoeff(), 0.0);
+  double area = 0;
+  for (Index f = 0; f < kept.mesh.num_faces(); ++f) {
+    EXPECT_GT(face_normal(kept.mesh.V, kept.mesh.F, f).z(), 0.0) << "face " << f << " folded";
+    area += face_area(kept.mesh.V, kept.mesh.F, f);
+  }
+  EXPECT_NEAR(area, 4.0, 1e-12);
+
+  options.keep_boundary = false;
+  const SimplifyResult free = simplify(grid.V, grid.F, options);
+  EXPECT_EQ(free.mesh.num_faces(), 2);
+  ASSERT_EQ(free.mesh.num_vertices(), 4);
+  for (Index v = 0; v < 4; ++v) {
+    EXPECT_NEAR(std::abs(free.mesh.V(v, 0)), 1.0, 1e-12);
+    EXPECT_NEAR(std::abs(free.mesh.V(v, 1)), 1.0, 1e-12);
+    EXPECT_NEAR(free.mesh.V(v, 2), 0.0, 1e-12);
+  }
+}
+
+TEST(Simplify, BudgetAtOrAboveTheInputChangesNothing) {
+  const Mesh torus = read_mesh(test::data_path("torus.obj"));
+  SimplifyOptions options;
+  options.target_faces = torus.num_faces();
+  const SimplifyResult result = simplify(torus.V, torus.F, options);
+  EXPECT_EQ(result.mesh.V, torus.V);
+  EXPECT_EQ(result.mesh.F, torus.F);
+  EXPECT_EQ(result.report.collapses, 0);
+}
+
+TEST(Simplify, RefusesWhatAHalfedgeMeshCannotHold) {
+  Mesh bowtie;
+  bowtie.V.resize(5, 3);
+  bowtie.V << 0, 0, 0, 1, 0, 0, 0, 1, 0, -1, 0, 0, 0, -1, 0;
+  bowtie.F.resize(2, 3);
+  bowtie.F << 0, 1, 2, 0, 3, 4;
+  try {
+    simplify(bowtie.V, bowtie.F);
+    FAIL() << "non-manifold mesh accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("simplify: the mesh is not manifold"), std::string::npos) << e.what();
+  }
+  Mesh flipped = test::icosphere(1.0, 1);
+  flipped.F.row(3) = flipped.F.row(3).reverse().eval();
+  try {
+    simplify(flipped.V, flipped.F);
+    FAIL() << "inconsistently oriented mesh accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("not consistently oriented"), std::string::npos) << e.what();
+  }
+  const Mesh sphere = test::icosphere(1.0, 1);
+  SimplifyOptions options;
+  options.target_ratio = 0;
+  EXPECT_THROW(simplify(sphere.V, sphere.F, options), std::invalid_argument);
+  options.target_ratio = 1.5;
+  EXPECT_THROW(simplify(sphere.V, sphere.F, options), std::invalid_argument);
+  options.target_faces = -3;
+  EXPECT_THROW(simplify(sphere.V, sphere.F, options), std::invalid_argument);
+  EXPECT_THROW(simplify(Vertices(), Faces()), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace vertexflow
