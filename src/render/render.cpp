@@ -12,8 +12,9 @@
 #include "vertexflow/topology.h"
 
 #define GL_GLEXT_PROTOTYPES
+#include <GL/osmesa.h>  // includes GL/gl.h, which glext.h needs first
+
 #include <GL/glext.h>
-#include <GL/osmesa.h>
 
 #include <ft2build.h>
 #include FT_FREETYPE_H
