@@ -237,8 +237,8 @@ TEST(Render, WireframeDrawsVisibleEdgesOnly) {
   const double scale = 0.92 * std::min(320 * (1 - kLegendWidthFraction) / (2 * half_x), 240 / (2 * half_y));
   double predicted = 0;
   const Topology topology = build_topology(front.F, front.num_vertices());
-  for (Index e = 0; e < topology.num_edges(); ++e) {
-    const Eigen::Vector3d d = front.V.row(topology.edges(e, 1)) - front.V.row(topology.edges(e, 0));
+  for (Index edge = 0; edge < topology.num_edges(); ++edge) {
+    const Eigen::Vector3d d = front.V.row(topology.edges(edge, 1)) - front.V.row(topology.edges(edge, 0));
     predicted += scale * std::max(std::abs(d.dot(right)), std::abs(d.dot(up)));
   }
   EXPECT_GT(half, 0.8 * predicted);
