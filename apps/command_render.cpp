@@ -24,6 +24,7 @@ struct RenderCommandOptions {
   std::string before;
   std::string frame_from;
   std::vector<double> frame;
+  std::optional<double> color_limit;
   bool wireframe = false;
   bool flat = false;
   bool smooth = false;
@@ -75,6 +76,11 @@ void register_render_command(CLI::App& app, const GlobalOptions& global) {
       ->expected(6)
       ->delimiter(',')
       ->excludes(frame_from);
+  command
+      ->add_option("--range", o->color_limit,
+                   "Fixed colour limit L: [-L, L] for curvature, [0, L] for displacement (default: the "
+                   "larger magnitude of the 5th and 95th percentiles); give before and after the same L")
+      ->check(CLI::PositiveNumber);
   command->add_option("--samples", o->render.samples, "Anti-aliasing samples per pixel (1 = off, default 4)")
       ->check(CLI::Range(1, 16));
   command->add_flag("--no-colorbar", o->no_color_bar, "Leave out the colour bar and its labels");
@@ -105,6 +111,7 @@ void register_render_command(CLI::App& app, const GlobalOptions& global) {
     options.shading = o->flat ? RenderShading::Flat : RenderShading::Smooth;
     options.wireframe = o->wireframe;
     options.color_bar = !o->no_color_bar;
+    options.color_limit = o->color_limit;
     if (!o->frame.empty()) {
       options.frame = BoundingBox{{o->frame[0], o->frame[1], o->frame[2]}, {o->frame[3], o->frame[4], o->frame[5]}};
       if (!(options.frame->max.array() >= options.frame->min.array()).all())

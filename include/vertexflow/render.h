@@ -53,7 +53,7 @@ enum class RenderColor {
   /// A uniform light grey.
   None,
   /// Mean curvature H = (k1 + k2) / 2 (curvature.h), diverging map (colormap.h), symmetric
-  /// range [-L, L] with L = robust_color_limit(H).
+  /// range [-L, L] with L = robust_color_limit(H) unless RenderOptions::color_limit is set.
   Mean,
   /// Gaussian curvature K = k1 k2, as Mean.
   Gauss,
@@ -61,7 +61,8 @@ enum class RenderColor {
   /// 1 (equilateral) white, 0 (degenerate) red.
   Quality,
   /// Per-vertex displacement length |V - reference| (RenderOptions::displacement_reference),
-  /// range [0, L] with L = robust_color_limit, white (0) to red (L).
+  /// range [0, L] with L = robust_color_limit (or RenderOptions::color_limit), white (0) to
+  /// red (L).
   Displacement,
 };
 
@@ -97,6 +98,10 @@ struct RenderOptions {
   std::array<std::uint8_t, 4> background{255, 255, 255, 255};
   /// Camera frame in mesh coordinates (see above); the mesh's bounding box when empty.
   std::optional<BoundingBox> frame;
+  /// Fixed colour-map limit L for Mean, Gauss (range [-L, L]) and Displacement ([0, L]),
+  /// instead of robust_color_limit of the data: give the same L to a before and an after
+  /// render so equal colours mean equal values. Must be > 0; ignored for None and Quality.
+  std::optional<double> color_limit;
   /// Positions before the flow, same vertex count and order as the mesh: required by
   /// RenderColor::Displacement, ignored otherwise.
   Vertices displacement_reference;

@@ -75,7 +75,7 @@ ScalarField scalar_field(const Mesh& mesh, const RenderOptions& options, const T
       const bool mean = options.color == RenderColor::Mean;
       field.values = mean ? c.mean() : c.gaussian();
       field.scale.quantity = mean ? "mean curvature" : "Gaussian curvature";
-      field.scale.limit = robust_color_limit(field.values);
+      field.scale.limit = options.color_limit ? *options.color_limit : robust_color_limit(field.values);
       field.scale.lo = -field.scale.limit;
       field.scale.hi = field.scale.limit;
       return field;
@@ -93,7 +93,7 @@ ScalarField scalar_field(const Mesh& mesh, const RenderOptions& options, const T
                         mesh.V.rows(), before.rows()));
       field.values = (mesh.V - before).rowwise().norm();
       field.scale.quantity = "displacement";
-      field.scale.limit = robust_color_limit(field.values);
+      field.scale.limit = options.color_limit ? *options.color_limit : robust_color_limit(field.values);
       field.scale.hi = field.scale.limit;
       return field;
     }
@@ -406,7 +406,7 @@ void draw_legend(Image& image, const ColorScale& scale, const RenderOptions& opt
   for (; size > 6; --size) {
     font.set_pixel_size(size);
     const int widest = std::max({font.width(scale.quantity), font.width(top), font.width(bottom)});
-    if (widest <= strip_w - 4) break;
+    if (widest <= strip_w - strip_w / 8) break;
   }
   const auto centred = [&](const std::string& text, int baseline) {
     font.draw(image, text, strip_x + (strip_w - font.width(text)) / 2, baseline, ink);
@@ -430,6 +430,8 @@ void check_options(const Mesh& mesh, const RenderOptions& options) {
   if (options.frame && !(options.frame->min.allFinite() && options.frame->max.allFinite() &&
                          (options.frame->max.array() >= options.frame->min.array()).all()))
     throw std::invalid_argument("the camera frame is not a finite box with min <= max");
+  if (options.color_limit && !(*options.color_limit > 0 && std::isfinite(*options.color_limit)))
+    throw std::invalid_argument("the colour limit must be a positive finite number");
   if (!(options.wireframe_width > 0 && options.wireframe_width <= 16))
     throw std::invalid_argument("wireframe width must be in (0, 16] pixels");
 }

@@ -362,8 +362,27 @@ TEST(Render, DisplacementColoursMovedVerticesRed) {
     return sum / std::max(n, 1L);
   };
   const int centre = static_cast<int>(320 * (1 - kLegendWidthFraction) / 2);
-  EXPECT_GT(redness(centre + 10, centre + 80), 60);
+  const double full_red = redness(centre + 10, centre + 80);
+  EXPECT_GT(full_red, 60);
   EXPECT_LT(std::abs(redness(centre - 80, centre - 10)), 15);
+
+  // A fixed limit twice the displacement: the moved half is only half-way to red.
+  options.color_limit = 0.2;
+  const Image fixed = render_mesh(after, options, &info);
+  EXPECT_EQ(info.color_max, 0.2);
+  const auto half_red = [&](int x0, int x1) {
+    double sum = 0;
+    long n = 0;
+    for (int y = 0; y < fixed.height; ++y)
+      for (int x = x0; x < x1; ++x)
+        if (const std::uint8_t* p = fixed.pixel(x, y); !is_background(p)) sum += p[0] - p[2], ++n;
+    return sum / std::max(n, 1L);
+  }(centre + 10, centre + 80);
+  EXPECT_GT(half_red, 0.3 * full_red);
+  EXPECT_LT(half_red, 0.7 * full_red);
+  options.color_limit = 0.0;
+  EXPECT_THROW(render_mesh(after, options), std::invalid_argument);
+  options.color_limit.reset();
 
   options.displacement_reference = before.V.topRows(10);
   EXPECT_THROW(render_mesh(after, options), std::invalid_argument);
@@ -421,11 +440,12 @@ TEST(RenderCli, DisplacementAgainstTheMeshBefore) {
   const std::string after = dir.file("after.ply").string();
   write_mesh(after, moved);
   const std::string out = dir.file("disp.png").string();
-  const test::CommandResult r =
-      test::run_cli("render " + test::shell_quote(after) + " " + test::shell_quote(out) +
-                    " --color displacement --before " + test::shell_quote(before) + " --size 200x150 --json");
+  const test::CommandResult r = test::run_cli("render " + test::shell_quote(after) + " " + test::shell_quote(out) +
+                                              " --color displacement --before " + test::shell_quote(before) +
+                                              " --size 200x150 --json --range 0.01");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("\"quantity\": \"displacement\""), std::string::npos) << r.out;
+  EXPECT_NE(r.out.find("\"max\": 0.01"), std::string::npos) << r.out;
   EXPECT_EQ(read_png(out).width, 200);
 
   // A different vertex count: one clear error naming the file, and no output.
