@@ -2,7 +2,9 @@
 //
 // Rendering runs on the CPU through Mesa's off-screen OpenGL (OSMesa, llvmpipe rasteriser):
 // no display and no GPU are needed. llvmpipe rasterises with LP_NUM_THREADS threads (default:
-// the number of cores, at most 16); the pixels do not depend on the thread count.
+// one per core); the pixels do not depend on the thread count. Mesa may keep compiled shaders
+// in its on-disk cache (~/.cache/mesa_shader_cache; MESA_SHADER_CACHE_DISABLE=true turns it
+// off).
 //
 // Conventions
 // - Camera: orthographic, so sizes compare across the image. The "camera frame" is a bounding
