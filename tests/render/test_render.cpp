@@ -430,6 +430,15 @@ TEST(RenderCli, WritesAPngAndPrintsTheRange) {
                 .exit_code,
             0);
   EXPECT_EQ(test::read_text(framed), test::read_text(out));
+
+  // llvmpipe on one rasteriser thread (instead of one per core): the same bytes.
+  const std::string one_thread = dir.file("one_thread.png").string();
+  ASSERT_EQ(
+      test::run_command("LP_NUM_THREADS=1 " + test::shell_quote(VERTEXFLOW_CLI) + " render " + test::shell_quote(in) +
+                        " " + test::shell_quote(one_thread) + " --wireframe --color mean --size 320x240 --flat")
+          .exit_code,
+      0);
+  EXPECT_EQ(test::read_text(one_thread), test::read_text(out));
 }
 
 TEST(RenderCli, DisplacementAgainstTheMeshBefore) {
