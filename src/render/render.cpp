@@ -129,8 +129,9 @@ Camera camera_for(const RenderOptions& options) {
   const double a = azimuth * std::numbers::pi / 180, e = elevation * std::numbers::pi / 180;
   Camera c;
   c.back = Eigen::Vector3d(std::cos(e) * std::sin(a), std::sin(e), std::cos(e) * std::cos(a));
-  // Up is +y projected into the image plane; looking straight down (or up) it is the
-  // direction the azimuth turns away from, so "top" has -z up.
+  // Up is +y projected into the image plane. Looking straight down (or up) that is undefined;
+  // then up is the horizontal direction away from the camera's azimuth, as if the camera had
+  // tilted down from the front: "top" has -z up.
   Eigen::Vector3d up = Eigen::Vector3d::UnitY() - c.back.y() * c.back;
   if (up.norm() < 1e-6) up = -Eigen::Vector3d(std::sin(a), 0, std::cos(a)) * (c.back.y() > 0 ? 1 : -1);
   c.up = up.normalized();
@@ -204,7 +205,7 @@ DrawArrays build_arrays(const Mesh& mesh, const RenderOptions& options, const Sc
 // OSMesa context and the buffer it renders into, destroyed together.
 class OffscreenContext {
  public:
-  OffscreenContext(int width, int height) : width_(width), height_(height) {
+  OffscreenContext(int width, int height) {
     const int attributes[] = {OSMESA_FORMAT,
                               OSMESA_RGBA,
                               OSMESA_DEPTH_BITS,
@@ -230,7 +231,6 @@ class OffscreenContext {
   [[nodiscard]] const std::vector<std::uint8_t>& buffer() const { return buffer_; }
 
  private:
-  int width_, height_;
   OSMesaContext context_ = nullptr;
   std::vector<std::uint8_t> buffer_;
 };
