@@ -34,5 +34,6 @@ void register_curvature_command(CLI::App& app, const GlobalOptions& global);
 void register_enhance_command(CLI::App& app, const GlobalOptions& global);
 void register_simplify_command(CLI::App& app, const GlobalOptions& global);
 void register_remesh_command(CLI::App& app, const GlobalOptions& global);
+void register_render_command(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace vertexflow::cli

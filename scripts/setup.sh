@@ -16,6 +16,9 @@ packages=(
   libfmt-dev               # formatting
   nlohmann-json3-dev       # JSON output
   zlib1g-dev               # gzip-compressed meshes
+  libosmesa6-dev           # off-screen software OpenGL (llvmpipe) for `vertexflow render`
+  libpng-dev               # PNG output of renders
+  libfreetype-dev fonts-dejavu-core  # colour-bar labels in renders
   libgtest-dev libgmock-dev
   libbenchmark-dev
   clang libclang-rt-14-dev # libFuzzer targets and sanitizers

@@ -1,0 +1,160 @@
+// `vertexflow render IN OUT.png [--color ...] [--wireframe] [--view ...] [--size WxH] [--flat|--smooth]
+// [--frame-from MESH | --frame BOX] [--before MESH]`: a headless picture of a mesh (render.h).
+// The colour range is printed on stdout (and drawn, labelled, in the image's colour bar).
+#include "cli_common.h"
+
+#include "vertexflow/render.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <cctype>
+#include <map>
+#include <regex>
+
+namespace vertexflow::cli {
+namespace {
+
+struct RenderCommandOptions {
+  std::string input;
+  std::string output;
+  std::string color = "none";
+  std::string view = "iso";
+  std::string size = "1600x1200";
+  std::string before;
+  std::string frame_from;
+  std::vector<double> frame;
+  std::optional<double> color_limit;
+  bool wireframe = false;
+  bool flat = false;
+  bool smooth = false;
+  bool no_color_bar = false;
+  bool json = false;
+  bool force = false;
+  RenderOptions render;
+};
+
+bool has_png_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext == ".png";
+}
+
+nlohmann::json box_json(const BoundingBox& box) {
+  return {box.min.x(), box.min.y(), box.min.z(), box.max.x(), box.max.y(), box.max.z()};
+}
+
+}  // namespace
+
+void register_render_command(CLI::App& app, const GlobalOptions& global) {
+  auto o = std::make_shared<RenderCommandOptions>();
+  CLI::App* command =
+      app.add_subcommand("render", "Render a mesh to a PNG image on the CPU (no display or GPU needed)");
+  command->add_option("IN", o->input, "Input mesh")->required();
+  command->add_option("OUT", o->output, "Output image (.png)")->required();
+  command
+      ->add_option("--color", o->color,
+                   "Colour by mean or Gaussian curvature (red positive, blue negative), triangle quality 2r/R "
+                   "(red = poor) or displacement from --before (white 0 .. red large)")
+      ->check(CLI::IsMember({"none", "mean", "gauss", "quality", "displacement"}));
+  command->add_option("--before", o->before,
+                      "The mesh before the flow (same vertices and order), for --color displacement");
+  command->add_flag("--wireframe", o->wireframe, "Draw the edges on the surface");
+  command->add_option("--view", o->view, "Camera direction (+y up): front (+z), side (+x), top (+y), iso, custom")
+      ->check(CLI::IsMember({"front", "side", "top", "iso", "custom"}));
+  command->add_option("--azimuth", o->render.azimuth_degrees, "Custom view: degrees about +y, from +z towards +x");
+  command->add_option("--elevation", o->render.elevation_degrees, "Custom view: degrees above the xz plane")
+      ->check(CLI::Range(-90.0, 90.0));
+  command->add_option("--size", o->size, "Image size WxH in pixels (default 1600x1200)");
+  auto* flat = command->add_flag("--flat", o->flat, "One normal per face: every triangle visible");
+  auto* smooth = command->add_flag("--smooth", o->smooth, "Interpolated vertex normals (default)");
+  flat->excludes(smooth);
+  auto* frame_from =
+      command->add_option("--frame-from", o->frame_from,
+                          "Use this mesh's bounding box as the camera frame, so renders of meshes sharing it line up");
+  command->add_option("--frame", o->frame, "Camera frame as a box: xmin ymin zmin xmax ymax zmax")
+      ->expected(6)
+      ->delimiter(',')
+      ->excludes(frame_from);
+  command
+      ->add_option("--range", o->color_limit,
+                   "Fixed colour limit L: [-L, L] for curvature, [0, L] for displacement (default: the "
+                   "larger magnitude of the 5th and 95th percentiles); give before and after the same L")
+      ->check(CLI::PositiveNumber);
+  command->add_option("--samples", o->render.samples, "Anti-aliasing samples per pixel (1 = off, default 4)")
+      ->check(CLI::Range(1, 16));
+  command->add_flag("--no-colorbar", o->no_color_bar, "Leave out the colour bar and its labels");
+  command->add_flag("--json", o->json, "Print the colour range, camera frame and timings as JSON on stdout");
+  command->add_flag("--force", o->force, "Allow OUT to be one of the input files");
+  command->callback([o, &global] {
+    for (const std::string& input : {o->input, o->before, o->frame_from})
+      if (!input.empty()) check_output_path(input, o->output, o->force, false);
+    if (!has_png_extension(o->output)) throw IoError(o->output + ": the output must be a .png file");
+    RenderOptions options = o->render;
+    std::smatch size;
+    if (!std::regex_match(o->size, size, std::regex(R"((\d{1,5})[xX](\d{1,5}))")))
+      throw std::invalid_argument("--size " + o->size + ": expected WIDTHxHEIGHT, e.g. 1600x1200");
+    options.width = std::stoi(size[1]);
+    options.height = std::stoi(size[2]);
+    const std::map<std::string, RenderView> views = {{"front", RenderView::Front},
+                                                     {"side", RenderView::Side},
+                                                     {"top", RenderView::Top},
+                                                     {"iso", RenderView::Iso},
+                                                     {"custom", RenderView::Custom}};
+    const std::map<std::string, RenderColor> colors = {{"none", RenderColor::None},
+                                                       {"mean", RenderColor::Mean},
+                                                       {"gauss", RenderColor::Gauss},
+                                                       {"quality", RenderColor::Quality},
+                                                       {"displacement", RenderColor::Displacement}};
+    options.view = views.at(o->view);
+    options.color = colors.at(o->color);
+    options.shading = o->flat ? RenderShading::Flat : RenderShading::Smooth;
+    options.wireframe = o->wireframe;
+    options.color_bar = !o->no_color_bar;
+    options.color_limit = o->color_limit;
+    if (!o->frame.empty()) {
+      options.frame = BoundingBox{{o->frame[0], o->frame[1], o->frame[2]}, {o->frame[3], o->frame[4], o->frame[5]}};
+      if (!(options.frame->max.array() >= options.frame->min.array()).all())
+        throw std::invalid_argument("--frame: every max must be >= its min (xmin ymin zmin xmax ymax zmax)");
+    }
+
+    const Mesh mesh = read_mesh_with_warnings(o->input, global);
+    if (!o->frame_from.empty()) options.frame = bounding_box(read_mesh_with_warnings(o->frame_from, global).V);
+    if (options.color == RenderColor::Displacement) {
+      if (o->before.empty()) throw std::invalid_argument("--color displacement needs --before MESH");
+      Mesh before = read_mesh_with_warnings(o->before, global);
+      if (before.num_vertices() != mesh.num_vertices())
+        throw IoError(fmt::format("{}: has {} vertices but {} has {}; displacement needs the same vertices", o->before,
+                                  before.num_vertices(), o->input, mesh.num_vertices()));
+      options.displacement_reference = std::move(before.V);
+    } else if (!o->before.empty() && !global.quiet) {
+      fmt::print(stderr, "vertexflow: warning: --before is only used with --color displacement\n");
+    }
+
+    RenderInfo info;
+    Image image;
+    try {
+      image = render_mesh(mesh, options, &info);
+    } catch (const std::invalid_argument& e) {
+      throw std::runtime_error(o->input + ": " + e.what());
+    }
+    write_png(o->output, image);
+    if (o->json) {
+      nlohmann::json out = {
+          {"input", o->input},
+          {"output", o->output},
+          {"width", image.width},
+          {"height", image.height},
+          {"frame", box_json(info.frame)},
+          {"seconds",
+           {{"prepare", info.prepare_seconds}, {"draw", info.draw_seconds}, {"readback", info.readback_seconds}}}};
+      if (options.color != RenderColor::None)
+        out["color"] = {{"quantity", info.color_quantity}, {"min", info.color_min}, {"max", info.color_max}};
+      fmt::print("{}\n", out.dump(2));
+    } else if (options.color != RenderColor::None) {
+      fmt::print("colour range ({}): [{:.6g}, {:.6g}]\n", info.color_quantity, info.color_min, info.color_max);
+    }
+  });
+}
+
+}  // namespace vertexflow::cli
