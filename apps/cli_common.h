@@ -32,5 +32,6 @@ nlohmann::json to_json(const ReadReport& report);
 void register_info_command(CLI::App& app, const GlobalOptions& global);
 void register_curvature_command(CLI::App& app, const GlobalOptions& global);
 void register_enhance_command(CLI::App& app, const GlobalOptions& global);
+void register_report_command(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace vertexflow::cli

@@ -18,6 +18,7 @@ int main(int argc, char** argv) {
   register_info_command(app, global);
   register_curvature_command(app, global);
   register_enhance_command(app, global);
+  register_report_command(app, global);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
