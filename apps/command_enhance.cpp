@@ -113,7 +113,7 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
           (std::filesystem::exists(o->report_file, ec) && std::filesystem::equivalent(o->report_file, o->output, ec)))
         throw IoError(o->report_file + ": the report would overwrite the output mesh");
     }
-    if (!o->html_file.empty()) check_report_output(o->html_file, {o->input}, {o->output, o->report_file}, o->force);
+    if (!o->html_file.empty()) check_report_output(o->html_file, {o->input}, {o->output, o->report_file});
     auto phase = [&](const std::string& what) {
       if (!global.quiet) fmt::print(stderr, "vertexflow: {}\n", what);
     };

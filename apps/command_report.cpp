@@ -18,7 +18,6 @@ struct ReportOptions {
   std::string html_file;
   std::string json_file;
   Index max_display_faces = HtmlReportOptions{}.max_display_faces;
-  bool force = false;
 };
 
 }  // namespace
@@ -36,10 +35,10 @@ void register_report_command(CLI::App& app, const GlobalOptions& global) {
                    "Show meshes with more faces decimated (vertex clustering) in the 3D views")
       ->check(CLI::Range(1, 2'000'000'000))
       ->capture_default_str();
-  command->add_flag("--force", o->force, "Allow an output to be one of the input files");
   command->callback([o, &global] {
-    check_report_output(o->html_file, {o->input, o->result}, {o->json_file}, o->force);
-    if (!o->json_file.empty()) check_report_output(o->json_file, {o->input, o->result}, {o->html_file}, o->force);
+    // Reports never replace a mesh: there is no --force here.
+    check_report_output(o->html_file, {o->input, o->result}, {o->json_file});
+    if (!o->json_file.empty()) check_report_output(o->json_file, {o->input, o->result}, {o->html_file});
     const Mesh input = read_mesh_with_warnings(o->input, global);
     const Mesh result = read_mesh_with_warnings(o->result, global);
     if (result.num_vertices() != input.num_vertices() || result.F != input.F)

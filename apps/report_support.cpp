@@ -49,8 +49,8 @@ nlohmann::json flow_metrics(const Vertices& input, const Vertices& result, const
 }
 
 void check_report_output(const std::filesystem::path& output, const std::vector<std::filesystem::path>& inputs,
-                         const std::vector<std::filesystem::path>& other_outputs, bool force) {
-  for (const auto& input : inputs) check_output_path(input, output, force, /*mesh_output=*/false);
+                         const std::vector<std::filesystem::path>& other_outputs) {
+  for (const auto& input : inputs) check_output_path(input, output, /*force=*/false, /*mesh_output=*/false);
   for (const auto& other : other_outputs) {
     if (other.empty()) continue;
     std::error_code ec;

@@ -19,11 +19,11 @@ namespace vertexflow::cli {
 /// for a non-manifold mesh (curvature.h).
 nlohmann::json flow_metrics(const Vertices& input, const Vertices& result, const Faces& F);
 
-/// Throws IoError unless the (non-mesh) file `output` may be written: not a directory, none of
-/// `inputs` (unless force), and none of the other outputs of the same command (empty paths
-/// are skipped).
+/// Throws IoError unless the report file `output` may be written: not a directory, none of
+/// `inputs` (even with --force: a report never replaces a mesh), and none of the other outputs
+/// of the same command (empty paths are skipped).
 void check_report_output(const std::filesystem::path& output, const std::vector<std::filesystem::path>& inputs,
-                         const std::vector<std::filesystem::path>& other_outputs, bool force);
+                         const std::vector<std::filesystem::path>& other_outputs);
 
 /// HTML report options whose title and labels name the two mesh files.
 HtmlReportOptions html_report_options(const std::filesystem::path& input, const std::filesystem::path& result);

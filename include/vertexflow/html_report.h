@@ -20,8 +20,9 @@
 //
 // Large meshes: above `max_display_faces` faces the views show a vertex-clustering
 // decimation (one clustering of the input's vertices, applied to both meshes so they keep a
-// shared connectivity and the displacement map still matches), and the page says so. The
-// histograms and metrics always describe the full meshes.
+// shared connectivity and the displacement map still matches), and the page says so. A merged
+// vertex shows the mean position and mean H / displacement of its vertices, a kept face the
+// mean quality of the faces merged into it. Histograms and metrics describe the full meshes.
 #pragma once
 
 #include "vertexflow/mesh.h"

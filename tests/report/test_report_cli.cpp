@@ -79,7 +79,9 @@ TEST(CliReport, NeverOverwritesAnInputAndFailsOnOneLine) {
         "report " + q(copy) + " " + q(test::data_path("fandisk.off")) + " " + q(copy),
         "report " + q(test::data_path("fandisk.off")) + " " + q(copy) + " " + q(copy),
         "report " + q(copy) + " " + q(copy) + " " + q(dir.file("r.html")) + " --json-report " + q(copy),
-        "enhance " + q(copy) + " " + q(dir.file("o.ply")) + " --html " + q(copy)}) {
+        "enhance " + q(copy) + " " + q(dir.file("o.ply")) + " --html " + q(copy),
+        // --force lets enhance replace its input mesh, never by a report.
+        "enhance " + q(copy) + " " + q(dir.file("o.ply")) + " --html " + q(copy) + " --force"}) {
     const auto r = run_cli(args);
     EXPECT_EQ(r.exit_code, 1) << args;
     EXPECT_NE(r.err.find("refusing to overwrite"), std::string::npos) << r.err;
