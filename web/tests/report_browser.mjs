@@ -185,11 +185,12 @@ async function testInteraction(page, name, input, result, views) {
     `${turned.changed} pixels changed`);
 }
 
-// Root (as in CI) needs --no-sandbox; SwiftShader gives WebGL without a GPU.
+// Root (as in CI) needs --no-sandbox; SwiftShader gives WebGL without a GPU; a small /dev/shm
+// (containers) must not starve the renderer.
 const browser = await chromium.launch({
   executablePath,
   headless: true,
-  args: ['--no-sandbox', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
+  args: ['--no-sandbox', '--disable-dev-shm-usage', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
 });
 try {
   await testReport(browser, fullReport, { decimated: false, interact: true });
