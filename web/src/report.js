@@ -101,7 +101,8 @@ class View {
       polygonOffsetFactor: 1,
       polygonOffsetUnits: 1,
     });
-    this.wireMaterial = new MeshBasicMaterial({ color: 0x1a1a1a, wireframe: true });
+    // Half-transparent lines, so dense meshes do not turn black and the colour map shows through.
+    this.wireMaterial = new MeshBasicMaterial({ color: 0x101010, wireframe: true, transparent: true, opacity: 0.45 });
     this.surface = new Mesh(this.geometry, this.material);
     this.wire = new Mesh(this.geometry, this.wireMaterial);
     this.wire.visible = false;
