@@ -7,8 +7,9 @@
 // display limit, so the decimated path is drawn too), opens each from file:// with every
 // non-file request refused, and checks: no console errors or page errors, no network request,
 // both canvases show a mesh (pixels that are not background), and on the first report: the
-// wireframe toggle and each colour map change the picture, the curvature map has red and blue,
-// and dragging one view turns the other. Prints one line per check and "N passed, M failed"; exit 1 on a failure.
+// wireframe toggle and each colour map change both views, the curvature map has red and blue,
+// and dragging the input view turns the result view too. Prints one line per check and
+// "N passed, M failed"; exit 1 on a failure.
 import { execFileSync } from 'node:child_process';
 import { mkdirSync, rmSync, statSync } from 'node:fs';
 import path from 'node:path';
@@ -52,11 +53,25 @@ const decimatedReport = path.join(work, 'fandisk_decimated.html');
 run('enhance', mesh, enhanced, '--html', fullReport);
 run('report', mesh, enhanced, decimatedReport, '--max-display-faces', '3000');
 
-// Counts pixels of a PNG screenshot in the page itself (no PNG decoder needed in Node): those
-// that differ from the white background, strongly red or blue ones, and (given a second PNG)
-// those that differ between the two.
-async function analyse(page, png, other = null) {
-  return page.evaluate(async ([a, b]) => {
+// One screenshot of the strip holding both canvases (few screenshots: each costs a software
+// render and a PNG round trip), and where each canvas lies in it.
+async function shoot(page, tag) {
+  const boxes = await Promise.all(['#view-input', '#view-result'].map((id) => page.locator(id).boundingBox()));
+  const x = Math.floor(boxes[0].x), y = Math.floor(Math.min(boxes[0].y, boxes[1].y));
+  const clip = { x, y, width: Math.ceil(boxes[1].x + boxes[1].width) - x, height: Math.ceil(boxes[0].height) };
+  const png = await page.screenshot({ clip });
+  if (keepShots) await page.screenshot({ clip, path: path.join(work, `${tag}.png`) });
+  const rects = boxes.map((b) => ({
+    x: Math.ceil(b.x - x) + 1, y: Math.ceil(b.y - y) + 1, width: Math.floor(b.width) - 2, height: Math.floor(b.height) - 2,
+  }));
+  return { png, rects };
+}
+
+// Per canvas (input, result): pixels that are not the white background, strongly red or blue
+// ones, and (given an earlier shot) pixels that changed. Decoded in the page itself, so Node
+// needs no PNG decoder.
+async function analyse(page, shot, earlier = null) {
+  return page.evaluate(async ([a, b, rects]) => {
     const load = async (base64) => {
       const image = new Image();
       image.src = `data:image/png;base64,${base64}`;
@@ -66,23 +81,28 @@ async function analyse(page, png, other = null) {
       canvas.height = image.height;
       const context = canvas.getContext('2d');
       context.drawImage(image, 0, 0);
-      return context.getImageData(0, 0, image.width, image.height).data;
+      return { data: context.getImageData(0, 0, image.width, image.height).data, width: image.width };
     };
-    const pixels = await load(a);
+    const first = await load(a);
     const second = b ? await load(b) : null;
-    let foreground = 0, red = 0, blue = 0, changed = 0;
-    for (let i = 0; i < pixels.length; i += 4) {
-      const [r, g, bl] = [pixels[i], pixels[i + 1], pixels[i + 2]];
-      if (r < 245 || g < 245 || bl < 245) ++foreground;
-      if (r > bl + 60 && r > g + 60) ++red;
-      if (bl > r + 60 && bl > g + 30) ++blue;
-      if (second) {
-        const d = Math.abs(r - second[i]) + Math.abs(g - second[i + 1]) + Math.abs(bl - second[i + 2]);
-        if (d > 30) ++changed;
+    return rects.map((rect) => {
+      let foreground = 0, red = 0, blue = 0, changed = 0;
+      for (let row = rect.y; row < rect.y + rect.height; ++row) {
+        for (let col = rect.x; col < rect.x + rect.width; ++col) {
+          const i = 4 * (row * first.width + col);
+          const [r, g, bl] = [first.data[i], first.data[i + 1], first.data[i + 2]];
+          if (r < 245 || g < 245 || bl < 245) ++foreground;
+          if (r > bl + 60 && r > g + 60) ++red;
+          if (bl > r + 60 && bl > g + 30) ++blue;
+          if (second) {
+            const o = second.data;
+            if (Math.abs(r - o[i]) + Math.abs(g - o[i + 1]) + Math.abs(bl - o[i + 2]) > 30) ++changed;
+          }
+        }
       }
-    }
-    return { total: pixels.length / 4, foreground, red, blue, changed };
-  }, [png.toString('base64'), other ? other.toString('base64') : null]);
+      return { total: rect.width * rect.height, foreground, red, blue, changed };
+    });
+  }, [shot.png.toString('base64'), earlier ? earlier.png.toString('base64') : null, shot.rects]);
 }
 
 async function frames(page) {
@@ -96,9 +116,11 @@ async function afterRedraw(page, action) {
   await page.waitForFunction((n) => Number(document.body.dataset.frames ?? 0) > n, before, { timeout: 10000 });
 }
 
+const VIEWS = ['input', 'result'];
+
 async function testReport(browser, file, { decimated, interact }) {
   const name = path.basename(file);
-  const context = await browser.newContext({ viewport: { width: 1000, height: 760 } });
+  const context = await browser.newContext({ viewport: { width: 900, height: 700 } });
   const requests = [];
   await context.route('**/*', (route) => {
     const url = route.request().url();
@@ -122,15 +144,12 @@ async function testReport(browser, file, { decimated, interact }) {
   console.log(`${name}: ${(statSync(file).size / 1e6).toFixed(2)} MB, first frame after ${loadMs} ms`);
   check(await page.evaluate(() => document.body.dataset.ready === '1'), `${name}: viewer started (WebGL available)`);
 
-  const input = page.locator('#view-input');
-  const result = page.locator('#view-result');
-  for (const [label, canvas] of [['input', input], ['result', result]]) {
-    const stats = await analyse(page, await canvas.screenshot());
-    check(stats.foreground > 0.03 * stats.total, `${name}: ${label} canvas shows a mesh`,
-      `${stats.foreground} of ${stats.total} pixels not background`);
-  }
+  const plain = await shoot(page, `${name}.plain`);
+  (await analyse(page, plain)).forEach((stats, k) =>
+    check(stats.foreground > 0.03 * stats.total, `${name}: ${VIEWS[k]} canvas shows a mesh`,
+      `${stats.foreground} of ${stats.total} pixels not background`));
 
-  if (interact) await testInteraction(page, name, input, result, page.locator('#views'));
+  if (interact) await testInteraction(page, name, plain);
 
   const note = await page.locator('#decimation-note').count();
   check(note === (decimated ? 1 : 0), `${name}: decimation note ${decimated ? 'shown' : 'absent'}`);
@@ -141,48 +160,39 @@ async function testReport(browser, file, { decimated, interact }) {
   await context.close();
 }
 
-// Toggles and orbiting change the picture.
-async function testInteraction(page, name, input, result, views) {
-  const shot = async (tag) => {
-    const png = await views.screenshot();
-    if (keepShots) await views.screenshot({ path: path.join(work, `${name}.${tag}.png`) });
-    return png;
-  };
-  const plain = await shot('plain');
+// Toggles and orbiting change the picture of both views.
+async function testInteraction(page, name, plain) {
+  const changedBoth = (stats) => stats.every((s) => s.changed > 0.01 * s.total);
+  const changes = (stats) => stats.map((s) => s.changed).join(' and ');
 
   await afterRedraw(page, () => page.locator('#wireframe').check());
-  const wire = await shot('wireframe');
-  const wireStats = await analyse(page, wire, plain);
-  check(wireStats.changed > 0.01 * wireStats.total, `${name}: wireframe toggle changes the picture`,
-    `${wireStats.changed} pixels changed`);
+  const wire = await analyse(page, await shoot(page, `${name}.wireframe`), plain);
+  check(changedBoth(wire), `${name}: wireframe toggle changes both views`, `${changes(wire)} pixels changed`);
   await afterRedraw(page, () => page.locator('#wireframe').uncheck());
-  const back = await analyse(page, await shot('plain-again'), plain);
-  check(back.changed < 0.001 * back.total, `${name}: wireframe off restores the picture`, `${back.changed} pixels differ`);
 
   for (const map of ['mean_curvature', 'quality', 'displacement']) {
     await afterRedraw(page, () => page.locator('#colormap').selectOption(map));
-    const stats = await analyse(page, await shot(map), plain);
-    check(stats.changed > 0.01 * stats.total, `${name}: colour map ${map} changes the picture`,
-      `${stats.changed} pixels changed`);
+    const stats = await analyse(page, await shoot(page, `${name}.${map}`), plain);
+    check(changedBoth(stats), `${name}: colour map ${map} changes both views`, `${changes(stats)} pixels changed`);
     if (map === 'mean_curvature')
-      check(stats.red > 100 && stats.blue > 100, `${name}: mean curvature map has red (convex) and blue (concave)`,
-        `red ${stats.red}, blue ${stats.blue}`);
-    if (map === 'displacement') check(stats.red > 100, `${name}: displacement map has red (moved) vertices`);
+      check(stats.every((s) => s.red > 100 && s.blue > 100),
+        `${name}: mean curvature map has red (convex) and blue (concave)`,
+        stats.map((s) => `red ${s.red}, blue ${s.blue}`).join('; '));
+    if (map === 'displacement') check(stats.every((s) => s.red > 100), `${name}: displacement map has red (moved) vertices`);
   }
   await afterRedraw(page, () => page.locator('#colormap').selectOption('none'));
 
-  // Orbit the input view; the result view must turn with it.
-  const resultBefore = await result.screenshot();
-  const box = await input.boundingBox();
+  // Orbit the input view; the result view must turn with it. Back to plain shading, the
+  // picture before the drag is `plain`.
+  const box = await page.locator('#view-input').boundingBox();
   await afterRedraw(page, async () => {
     await page.mouse.move(box.x + box.width / 2, box.y + box.height / 2);
     await page.mouse.down();
     await page.mouse.move(box.x + box.width / 2 + 150, box.y + box.height / 2 + 40, { steps: 5 });
     await page.mouse.up();
   });
-  const turned = await analyse(page, await result.screenshot(), resultBefore);
-  check(turned.changed > 0.01 * turned.total, `${name}: dragging the input view turns the result view`,
-    `${turned.changed} pixels changed`);
+  const turned = await analyse(page, await shoot(page, `${name}.turned`), plain);
+  check(changedBoth(turned), `${name}: dragging the input view turns both views`, `${changes(turned)} pixels changed`);
 }
 
 // Root (as in CI) needs --no-sandbox; SwiftShader gives WebGL without a GPU; a small /dev/shm
