@@ -54,10 +54,12 @@ void register_report_command(CLI::App& app, const GlobalOptions& global) {
     }
     metrics["input"] = o->input;
     metrics["output"] = o->result;
-    if (!o->json_file.empty()) write_text_file(o->json_file, metrics.dump(2) + "\n");
+    // File names need not be UTF-8: dump with U+FFFD for invalid bytes instead of failing.
+    const auto replace = nlohmann::json::error_handler_t::replace;
+    if (!o->json_file.empty()) write_text_file(o->json_file, metrics.dump(2, ' ', false, replace) + "\n");
     HtmlReportOptions options = html_report_options(o->input, o->result);
     options.max_display_faces = o->max_display_faces;
-    write_html_report(o->html_file, input, result, metrics.dump(), options);
+    write_html_report(o->html_file, input, result, metrics.dump(-1, ' ', false, replace), options);
     if (!global.quiet) fmt::print(stderr, "vertexflow: HTML report written to {}\n", o->html_file);
   });
 }

@@ -235,10 +235,11 @@ std::string escape_html(std::string_view text) {
   return out;
 }
 
-// JSON that is safe inside <script>: every '<' (only possible inside strings) as \u003c, so no
-// "</script>" or "<!--" in a file name can end or confuse the element.
+// JSON that is safe inside <script>: ASCII only, and every '<' (only possible inside strings)
+// as \u003c, so no "</script>" or "<!--" in a file name can end or confuse the element.
 std::string script_safe_json(const Json& json) {
-  const std::string text = json.dump(-1, ' ', /*ensure_ascii=*/true);
+  // File names need not be UTF-8: invalid bytes become U+FFFD rather than an exception.
+  const std::string text = json.dump(-1, ' ', /*ensure_ascii=*/true, Json::error_handler_t::replace);
   std::string out;
   out.reserve(text.size());
   for (const char c : text) {

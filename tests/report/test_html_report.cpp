@@ -257,6 +257,9 @@ TEST(HtmlReport, NamesCannotBreakOutOfThePage) {
   EXPECT_EQ(data["title"], options.title);
   EXPECT_EQ(data["labels"]["input"], "</script><!--");
   EXPECT_EQ(data["metrics"]["file"], "</script>");
+  // A label that is not UTF-8 (file names need not be) is replaced, not an error.
+  options.input_label = "bad\xff.off";
+  EXPECT_EQ(page_data(html_report(p.input, p.result, "", options))["labels"]["input"], "bad\xef\xbf\xbd.off");
 }
 
 TEST(HtmlReport, RefusesMismatchedMeshesAndBadMetrics) {
