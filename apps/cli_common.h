@@ -35,5 +35,6 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global);
 void register_simplify_command(CLI::App& app, const GlobalOptions& global);
 void register_remesh_command(CLI::App& app, const GlobalOptions& global);
 void register_render_command(CLI::App& app, const GlobalOptions& global);
+void register_report_command(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace vertexflow::cli

@@ -1,8 +1,10 @@
 // `vertexflow enhance IN OUT [...]`: vertex flow (paper sections 3-4), with a JSON report of
 // what it did.
 #include "cli_common.h"
+#include "report_support.h"
 
 #include "vertexflow/flow.h"
+#include "vertexflow/html_report.h"
 #include "vertexflow/metrics.h"
 #include "vertexflow/quality.h"
 #include "vertexflow/unsharp.h"
@@ -21,6 +23,7 @@ struct EnhanceOptions {
   std::string output;
   std::string pin_file;
   std::string report_file;
+  std::string html_file;
   FlowOptions flow;
   std::string method = "flow";
   UnsharpOptions unsharp;
@@ -58,12 +61,6 @@ std::vector<Index> read_pins(const std::string& path, Index num_vertices) {
 
 double seconds_since(std::chrono::steady_clock::time_point start) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
-
-double signed_volume(const Vertices& V, const Faces& F) {
-  double volume = 0;
-  for (Index f = 0; f < F.rows(); ++f) volume += V.row(F(f, 0)).dot(V.row(F(f, 1)).cross(V.row(F(f, 2)))) / 6.0;
-  return volume;
 }
 
 // The unsharp-mask baseline (unsharp.h) in the flow's result type, so that both methods share
@@ -130,6 +127,8 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
   command->add_option("--pin", o->pin_file, "File of vertex indices (0-based) to hold in place");
   command->add_flag("--free-boundary", o->keep_boundary_free, "Let boundary vertices move (default: fixed)");
   command->add_option("--report", o->report_file, "Write a JSON report: options, timings per phase, metrics");
+  command->add_option("--html", o->html_file,
+                      "Write an HTML report: both meshes in 3D, colour maps, histograms, metrics");
   command->add_flag("--force", o->force, "Allow OUT to be the input file");
   command->callback([o, &global, command, weight, smoothing] {
     const bool unsharp = o->method == "unsharp";
@@ -148,6 +147,7 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
           (std::filesystem::exists(o->report_file, ec) && std::filesystem::equivalent(o->report_file, o->output, ec)))
         throw IoError(o->report_file + ": the report would overwrite the output mesh");
     }
+    if (!o->html_file.empty()) check_report_output(o->html_file, {o->input}, {o->output, o->report_file});
     auto phase = [&](const std::string& what) {
       if (!global.quiet) fmt::print(stderr, "vertexflow: {}\n", what);
     };
@@ -189,19 +189,10 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     write_mesh(o->output, out);
     const double seconds_write = seconds_since(start);
 
-    if (!o->report_file.empty()) {
-      const Topology topology = build_topology(mesh.F, mesh.num_vertices());
-      const Curvature surface = principal_curvatures(mesh.V, mesh.F, topology);
-      const Eigen::VectorXd magnitude = surface.absolute_sum();
-      const EdgeErrorStats before = edge_error_stats(mesh.V, topology, surface);
-      const EdgeErrorStats after = edge_error_stats(result.V, topology, surface);
-      const Eigen::VectorXd moved = (result.V - mesh.V).rowwise().norm() / r.mean_edge_length;
-      const double volume_before = signed_volume(mesh.V, mesh.F);
-      nlohmann::json report;
+    if (!o->report_file.empty() || !o->html_file.empty()) {
+      nlohmann::json report = flow_metrics(mesh.V, result.V, mesh.F);
       report["input"] = o->input;
       report["output"] = o->output;
-      report["vertices"] = mesh.num_vertices();
-      report["faces"] = mesh.num_faces();
       report["options"] = {
           {"lambda", o->flow.lambda},
           {"mu", o->flow.mu},
@@ -214,26 +205,15 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
           {"project_to_input", o->flow.project_to_input},
           {"feature_angle", o->flow.feature_angle},
           {"fairness_target", o->flow.fairness_target == FairnessTarget::Zero ? "zero" : "input-normal"}};
-      report["seconds"] = {{"read", seconds_read},           {"curvature", r.seconds_curvature},
-                           {"assembly", r.seconds_assembly}, {"solve", r.seconds_solve},
-                           {"guard", r.seconds_guard},       {"write", seconds_write}};
+      report["seconds"] = {
+          {"read", seconds_read},     {"curvature", r.seconds_curvature},   {"assembly", r.seconds_assembly},
+          {"solve", r.seconds_solve}, {"projection", r.seconds_projection}, {"guard", r.seconds_guard},
+          {"write", seconds_write}};
       report["solver"] = {{"relative_residual", r.solver_error}, {"d", r.d}, {"mean_edge_length", r.mean_edge_length}};
       report["guard"] = {{"faces_bad_before_guard", r.flipped_before_guard},
                          {"faces_low_quality_before_guard", r.low_quality_before_guard},
                          {"limited_vertices", r.limited_vertices},
                          {"fixed_vertices", r.fixed_vertices}};
-      report["flipped_faces"] = flipped_faces(mesh.V, result.V, mesh.F).size();
-      report["degenerate_faces"] = degenerate_faces(result.V, mesh.F).size();
-      report["quality_input"] = to_json(summarize_quality(triangle_quality(mesh.V, mesh.F)));
-      report["quality_result"] = to_json(summarize_quality(triangle_quality(result.V, mesh.F)));
-      report["displacement_edge_lengths"] = {{"mean", moved.mean()}, {"max", moved.maxCoeff()}};
-      report["redistribution_rho"] = {{"input", redistribution_rho(magnitude, mesh.V, mesh.F)},
-                                      {"result", redistribution_rho(magnitude, result.V, mesh.F)}};
-      report["edge_error_cv"] = {{"input", before.coefficient_of_variation},
-                                 {"result", after.coefficient_of_variation}};
-      report["volume_change_percent"] =
-          volume_before != 0 ? 100.0 * (signed_volume(result.V, mesh.F) - volume_before) / std::abs(volume_before)
-                             : 0.0;
       report["method"] = o->method;
       if (unsharp) {  // the flow's options, solver and guard do not apply
         report["options"] = {{"weight", o->unsharp.weight},
@@ -245,8 +225,14 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
         report.erase("guard");
         report["fixed_vertices"] = r.fixed_vertices;
       }
-      write_text_file(o->report_file, report.dump(2) + "\n");
-      phase("report written to " + o->report_file);
+      if (!o->report_file.empty()) {
+        write_text_file(o->report_file, report.dump(2) + "\n");
+        phase("report written to " + o->report_file);
+      }
+      if (!o->html_file.empty()) {
+        write_html_report(o->html_file, mesh, out, report.dump(), html_report_options(o->input, o->output));
+        phase("HTML report written to " + o->html_file);
+      }
     }
   });
 }

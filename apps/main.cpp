@@ -21,6 +21,7 @@ int main(int argc, char** argv) {
   register_simplify_command(app, global);
   register_remesh_command(app, global);
   register_render_command(app, global);
+  register_report_command(app, global);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

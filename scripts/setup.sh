@@ -23,20 +23,32 @@ packages=(
   libbenchmark-dev
   clang libclang-rt-14-dev # libFuzzer targets and sanitizers
   clang-format
+  chromium chromium-driver # headless browser test of the HTML report (tests/CMakeLists.txt)
 )
 
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
 done
+# Node.js and npm build the HTML report's viewer (web/). A Node.js already on the machine counts
+# (some builds bundle npm and conflict with Debian's npm package); otherwise Debian's.
+if ! command -v node >/dev/null || ! command -v npm >/dev/null; then missing+=(nodejs npm); fi
 
-if [ ${#missing[@]} -eq 0 ]; then
-  exit 0
+if [ ${#missing[@]} -ne 0 ]; then
+  echo "setup: installing ${missing[*]}" >&2
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+  export DEBIAN_FRONTEND=noninteractive
+  $SUDO apt-get update -qq
+  $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 
-echo "setup: installing ${missing[*]}" >&2
-SUDO=""
-if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
-export DEBIAN_FRONTEND=noninteractive
-$SUDO apt-get update -qq
-$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+# npm packages of web/ (three.js, esbuild, playwright-core) exactly as package-lock.json pins
+# them; skipped when node_modules was installed from this very lock file.
+web="$(cd "$(dirname "$0")/.." && pwd)/web"
+stamp="$web/node_modules/.vertexflow-package-lock.json"
+if ! cmp -s "$web/package-lock.json" "$stamp"; then
+  echo "setup: npm ci in $web" >&2
+  (cd "$web" && npm ci --no-audit --no-fund --loglevel=error)
+  cp "$web/package-lock.json" "$stamp"
+fi

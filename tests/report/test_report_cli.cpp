@@ -1,0 +1,112 @@
+// `vertexflow report` and `vertexflow enhance --html` end to end: files written, inputs never
+// overwritten, one-line errors.
+#include "test_support.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <filesystem>
+
+namespace vertexflow {
+namespace {
+
+using test::run_cli;
+using test::shell_quote;
+
+std::string q(const std::filesystem::path& path) {
+  return shell_quote(path.string());
+}
+
+TEST(CliReport, EnhanceWritesTheHtmlReportWithTheJsonMetrics) {
+  test::ScratchDir dir("cli-report-enhance");
+  const auto out = dir.file("out.ply"), json = dir.file("r.json"), html = dir.file("r.html");
+  const auto r = run_cli("enhance " + q(test::data_path("fandisk.off")) + " " + q(out) + " --report " + q(json) +
+                         " --html " + q(html));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const std::string page = test::read_text(html);
+  ASSERT_FALSE(page.empty());
+  // The metrics table holds the --report JSON (timings, options and all).
+  const auto report = nlohmann::json::parse(test::read_text(json));
+  const std::string open = R"(<script id="vertexflow-data" type="application/json">)";
+  const std::size_t begin = page.find(open) + open.size();
+  const auto data = nlohmann::json::parse(page.substr(begin, page.find("</script>", begin) - begin));
+  EXPECT_EQ(data["metrics"], report);
+  EXPECT_EQ(data["labels"]["input"], "fandisk.off");
+  EXPECT_EQ(data["labels"]["result"], "out.ply");
+  EXPECT_NE(r.err.find("HTML report written to"), std::string::npos) << r.err;
+}
+
+TEST(CliReport, ReportOfAnExistingResult) {
+  test::ScratchDir dir("cli-report");
+  const auto input = test::data_path("fandisk.off");
+  const auto out = dir.file("out.ply"), json = dir.file("metrics.json"), html = dir.file("report.html");
+  ASSERT_EQ(
+      run_cli("--quiet enhance " + q(input) + " " + q(out) + " --report " + q(dir.file("enhance.json"))).exit_code, 0);
+  const auto r = run_cli("--quiet report " + q(input) + " " + q(out) + " " + q(html) + " --json-report " + q(json));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(r.err.empty()) << r.err;
+  EXPECT_FALSE(test::read_text(html).empty());
+  // The same metrics as enhance's own report (everything it measures, not the timings).
+  const auto metrics = nlohmann::json::parse(test::read_text(json));
+  const auto enhance = nlohmann::json::parse(test::read_text(dir.file("enhance.json")));
+  for (const char* key :
+       {"vertices", "faces", "flipped_faces", "degenerate_faces", "quality_input", "quality_result",
+        "redistribution_rho", "edge_error_cv", "displacement_edge_lengths", "volume_change_percent"}) {
+    ASSERT_TRUE(metrics.contains(key)) << key;
+    EXPECT_EQ(metrics[key].dump().substr(0, 40), enhance[key].dump().substr(0, 40)) << key;
+  }
+}
+
+TEST(CliReport, DecimationLimitOption) {
+  test::ScratchDir dir("cli-report-decimate");
+  const auto mesh = test::data_path("fandisk.off");
+  const auto html = dir.file("r.html");
+  // The input compared with itself: a valid (if dull) report.
+  const auto r = run_cli("--quiet report " + q(mesh) + " " + q(mesh) + " " + q(html) + " --max-display-faces 2000");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(test::read_text(html).find("decimation for display"), std::string::npos);
+  EXPECT_NE(run_cli("report " + q(mesh) + " " + q(mesh) + " " + q(html) + " --max-display-faces 0").exit_code, 0);
+}
+
+TEST(CliReport, NeverOverwritesAnInputAndFailsOnOneLine) {
+  test::ScratchDir dir("cli-report-refuse");
+  const auto copy = dir.file("in.off");
+  std::filesystem::copy_file(test::data_path("fandisk.off"), copy);
+  const std::string before = test::read_text(copy);
+  for (const std::string& args :
+       {"report " + q(copy) + " " + q(copy) + " " + q(copy),
+        "report " + q(copy) + " " + q(test::data_path("fandisk.off")) + " " + q(copy),
+        "report " + q(test::data_path("fandisk.off")) + " " + q(copy) + " " + q(copy),
+        "report " + q(copy) + " " + q(copy) + " " + q(dir.file("r.html")) + " --json-report " + q(copy),
+        "enhance " + q(copy) + " " + q(dir.file("o.ply")) + " --html " + q(copy),
+        // --force lets enhance replace its input mesh, never by a report.
+        "enhance " + q(copy) + " " + q(dir.file("o.ply")) + " --html " + q(copy) + " --force"}) {
+    const auto r = run_cli(args);
+    EXPECT_EQ(r.exit_code, 1) << args;
+    EXPECT_NE(r.err.find("refusing to overwrite"), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+  EXPECT_EQ(test::read_text(copy), before);
+  // The HTML report and the JSON report must be different files.
+  const auto same = run_cli("report " + q(copy) + " " + q(copy) + " " + q(dir.file("r.html")) + " --json-report " +
+                            q(dir.file("r.html")));
+  EXPECT_EQ(same.exit_code, 1);
+  EXPECT_NE(same.err.find("would overwrite another output"), std::string::npos) << same.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("r.html")));
+}
+
+TEST(CliReport, ResultOfAnotherMeshIsAnError) {
+  test::ScratchDir dir("cli-report-mismatch");
+  const auto r = run_cli("report " + q(test::data_path("fandisk.off")) + " " + q(test::data_path("torus.obj")) + " " +
+                         q(dir.file("r.html")));
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_EQ(r.err.rfind("vertexflow: error: " + test::data_path("torus.obj").string() + ": not the connectivity of", 0),
+            0u)
+      << r.err;
+  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("r.html")));
+}
+
+}  // namespace
+}  // namespace vertexflow
