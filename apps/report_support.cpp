@@ -11,15 +11,6 @@
 #include <system_error>
 
 namespace vertexflow::cli {
-namespace {
-
-double signed_volume(const Vertices& V, const Faces& F) {
-  double volume = 0;
-  for (Index f = 0; f < F.rows(); ++f) volume += V.row(F(f, 0)).dot(V.row(F(f, 1)).cross(V.row(F(f, 2)))) / 6.0;
-  return volume;
-}
-
-}  // namespace
 
 nlohmann::json flow_metrics(const Vertices& input, const Vertices& result, const Faces& F) {
   const Topology topology = build_topology(F, static_cast<Index>(input.rows()));

@@ -83,4 +83,9 @@ Eigen::Vector3d face_normal(const Vertices& V, const Faces& F, Index f);
 /// Area of triangle f.
 double face_area(const Vertices& V, const Faces& F, Index f);
 
+/// Signed volume enclosed by the faces, sum of v0 . (v1 x v2) / 6 (divergence theorem):
+/// positive for a closed mesh with outward orientation; for an open mesh, the volume of the
+/// cone from the origin (not translation-invariant).
+double signed_volume(const Vertices& V, const Faces& F);
+
 }  // namespace vertexflow

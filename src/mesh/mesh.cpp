@@ -43,4 +43,13 @@ Eigen::Vector3d face_normal(const Vertices& V, const Faces& F, Index f) {
 
 double face_area(const Vertices& V, const Faces& F, Index f) { return 0.5 * face_normal(V, F, f).norm(); }
 
+double signed_volume(const Vertices& V, const Faces& F) {
+  double volume = 0;
+  for (Index f = 0; f < F.rows(); ++f) {
+    const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
+    volume += a.dot(b.cross(c));
+  }
+  return volume / 6.0;
+}
+
 }  // namespace vertexflow

@@ -15,15 +15,6 @@
 namespace vertexflow {
 namespace {
 
-double signed_volume(const Vertices& V, const Faces& F) {
-  double volume = 0;
-  for (Index f = 0; f < F.rows(); ++f) {
-    const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), c = V.row(F(f, 2));
-    volume += a.dot(b.cross(c)) / 6.0;
-  }
-  return volume;
-}
-
 double mean_displacement(const Vertices& a, const Vertices& b) {
   return (a - b).rowwise().norm().mean();
 }
