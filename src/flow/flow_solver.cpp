@@ -82,7 +82,9 @@ void parallel_vertices(Index n, Body&& body) {
   });
 }
 
-Eigen::Map<Vector3> at(Vector& v, Index i) { return Eigen::Map<Vector3>(v.data() + 3 * static_cast<Eigen::Index>(i)); }
+Eigen::Map<Vector3> at(Vector& v, Index i) {
+  return Eigen::Map<Vector3>(v.data() + 3 * static_cast<Eigen::Index>(i));
+}
 Eigen::Map<const Vector3> at(const Vector& v, Index i) {
   return Eigen::Map<const Vector3>(v.data() + 3 * static_cast<Eigen::Index>(i));
 }
@@ -121,8 +123,8 @@ void use_single_threaded_blas() {
 // those meshes than on one whose file order is local (horse-48k).
 struct Terms {
   Index n = 0;
-  std::vector<Index> original;  // local index -> mesh vertex
-  std::vector<Index> local;     // mesh vertex -> local index
+  std::vector<Index> original;          // local index -> mesh vertex
+  std::vector<Index> local;             // mesh vertex -> local index
   std::vector<Index> ring_start, ring;  // one-rings in local indices
   std::vector<char> fixed;
   std::vector<Matrix3> K;  // K_i
@@ -133,7 +135,8 @@ struct Terms {
   std::vector<Vector3> rest;  // fairness target r_i
 
   [[nodiscard]] std::pair<const Index*, const Index*> one_ring(Index i) const {
-    return {ring.data() + ring_start[static_cast<std::size_t>(i)], ring.data() + ring_start[static_cast<std::size_t>(i) + 1]};
+    return {ring.data() + ring_start[static_cast<std::size_t>(i)],
+            ring.data() + ring_start[static_cast<std::size_t>(i) + 1]};
   }
 };
 
@@ -246,10 +249,13 @@ void add_from_local(const Terms& t, const Vector& x, double* out) {
 
 // The block G_iu of G for u in the star (one-ring and itself) of i.
 Matrix3 g_block(const Terms& t, Index i, Index u) {
-  return i == u ? t.G[static_cast<std::size_t>(i)] : Matrix3(-(t.K[static_cast<std::size_t>(i)] + t.K[static_cast<std::size_t>(u)]));
+  return i == u ? t.G[static_cast<std::size_t>(i)]
+                : Matrix3(-(t.K[static_cast<std::size_t>(i)] + t.K[static_cast<std::size_t>(u)]));
 }
 // The entry L_iu of the Laplacian.
-double l_entry(const Terms& t, Index i, Index u) { return i == u ? 1.0 : -t.inv_degree[static_cast<std::size_t>(i)]; }
+double l_entry(const Terms& t, Index i, Index u) {
+  return i == u ? 1.0 : -t.inv_degree[static_cast<std::size_t>(i)];
+}
 
 // H x (or, with with_d false and with_rest true, the part of H x - b that does not depend on D)
 // without forming H. Rows of fixed vertices are set to zero.
@@ -410,7 +416,7 @@ struct FlowSystemSolver::Impl {
   // Local numbering (Terms), chosen at the first solve and kept: the pattern and the ordering
   // below are in it.
   std::vector<Index> order;
-  std::vector<Index> free_index;  // local index -> free index, -1 for fixed vertices
+  std::vector<Index> free_index;   // local index -> free index, -1 for fixed vertices
   std::vector<Index> free_vertex;  // free index -> local index
   // Two-ring pattern of H over the free vertices, lower half by rows (= upper half by
   // columns): row a holds the free indices b <= a.
@@ -434,9 +440,7 @@ struct FlowSystemSolver::Impl {
   Impl(const Impl&) = delete;
   Impl& operator=(const Impl&) = delete;
 
-  [[nodiscard]] Index num_free() const {
-    return static_cast<Index>(std::count(fixed.begin(), fixed.end(), 0));
-  }
+  [[nodiscard]] Index num_free() const { return static_cast<Index>(std::count(fixed.begin(), fixed.end(), 0)); }
 
   void number_vertices(const Vertices& P) {
     if (!order.empty() || P.rows() == 0) return;
@@ -459,7 +463,8 @@ void FlowSystemSolver::Impl::build_pattern(const Terms& t) {
   if (pattern_built) return;
   const Index m = num_free(), n = static_cast<Index>(fixed.size());
   std::vector<std::vector<Index>> rows(static_cast<std::size_t>(m));
-  tbb::enumerable_thread_specific<std::vector<Index>> marks([n] { return std::vector<Index>(static_cast<std::size_t>(n), -1); });
+  tbb::enumerable_thread_specific<std::vector<Index>> marks(
+      [n] { return std::vector<Index>(static_cast<std::size_t>(n), -1); });
   parallel_vertices(m, [&](Index a) {
     std::vector<Index>& mark = marks.local();
     std::vector<Index>& row = rows[static_cast<std::size_t>(a)];
@@ -482,7 +487,8 @@ void FlowSystemSolver::Impl::build_pattern(const Terms& t) {
   });
   row_start.assign(static_cast<std::size_t>(m) + 1, 0);
   for (Index a = 0; a < m; ++a)
-    row_start[static_cast<std::size_t>(a) + 1] = row_start[static_cast<std::size_t>(a)] + static_cast<std::int64_t>(rows[static_cast<std::size_t>(a)].size());
+    row_start[static_cast<std::size_t>(a) + 1] =
+        row_start[static_cast<std::size_t>(a)] + static_cast<std::int64_t>(rows[static_cast<std::size_t>(a)].size());
   row_columns.resize(static_cast<std::size_t>(row_start.back()));
   parallel_vertices(m, [&](Index a) {
     const auto& row = rows[static_cast<std::size_t>(a)];
@@ -497,8 +503,8 @@ void FlowSystemSolver::Impl::order_vertices(const Terms& terms) {
   if (!vertex_permutation.empty() || num_free() == 0) return;
   build_pattern(terms);
   const Index m = num_free();
-  cholmod_sparse* pattern =
-      cholmod_l_allocate_sparse(static_cast<std::size_t>(m), static_cast<std::size_t>(m), row_columns.size(), 1, 1, 1, CHOLMOD_PATTERN, &common);
+  cholmod_sparse* pattern = cholmod_l_allocate_sparse(static_cast<std::size_t>(m), static_cast<std::size_t>(m),
+                                                      row_columns.size(), 1, 1, 1, CHOLMOD_PATTERN, &common);
   auto* p = static_cast<SuiteSparse_long*>(pattern->p);
   auto* i = static_cast<SuiteSparse_long*>(pattern->i);
   std::copy(row_start.begin(), row_start.end(), p);
@@ -524,14 +530,16 @@ cholmod_sparse* FlowSystemSolver::Impl::assemble(const Terms& t) {
   const Index m = num_free(), n = static_cast<Index>(fixed.size());
   std::vector<SuiteSparse_long> column_start(3 * static_cast<std::size_t>(m) + 1, 0);
   for (Index a = 0; a < m; ++a) {
-    const auto off_diagonal = 3 * (row_start[static_cast<std::size_t>(a) + 1] - row_start[static_cast<std::size_t>(a)] - 1);
+    const auto off_diagonal =
+        3 * (row_start[static_cast<std::size_t>(a) + 1] - row_start[static_cast<std::size_t>(a)] - 1);
     for (int r = 0; r < 3; ++r) {
       const std::size_t column = 3 * static_cast<std::size_t>(a) + static_cast<std::size_t>(r);
       column_start[column + 1] = column_start[column] + off_diagonal + r + 1;
     }
   }
   const auto entries = static_cast<std::size_t>(column_start.back());
-  cholmod_sparse* A = cholmod_l_allocate_sparse(3 * static_cast<std::size_t>(m), 3 * static_cast<std::size_t>(m), entries, 1, 1, 1, CHOLMOD_REAL, &common);
+  cholmod_sparse* A = cholmod_l_allocate_sparse(3 * static_cast<std::size_t>(m), 3 * static_cast<std::size_t>(m),
+                                                entries, 1, 1, 1, CHOLMOD_REAL, &common);
   if (!A) throw std::runtime_error("vertex flow: out of memory for the normal matrix");
   std::copy(column_start.begin(), column_start.end(), static_cast<SuiteSparse_long*>(A->p));
   auto* rows = static_cast<SuiteSparse_long*>(A->i);
@@ -544,7 +552,9 @@ cholmod_sparse* FlowSystemSolver::Impl::assemble(const Terms& t) {
     std::vector<Matrix3>& blocks = scratch.local();
     const auto first = row_start[static_cast<std::size_t>(a)], last = row_start[static_cast<std::size_t>(a) + 1];
     blocks.assign(static_cast<std::size_t>(last - first), Matrix3::Zero());
-    for (auto k = first; k < last; ++k) position[static_cast<std::size_t>(free_vertex[static_cast<std::size_t>(row_columns[static_cast<std::size_t>(k)])])] = k - first;
+    for (auto k = first; k < last; ++k)
+      position[static_cast<std::size_t>(
+          free_vertex[static_cast<std::size_t>(row_columns[static_cast<std::size_t>(k)])])] = k - first;
     const Index u = free_vertex[static_cast<std::size_t>(a)];
     // Block (u, w) = sum over i whose star holds u and w of G_iu P_i G_iw + S_i L_iu L_iw I.
     auto add_star = [&](Index i) {
@@ -565,7 +575,9 @@ cholmod_sparse* FlowSystemSolver::Impl::assemble(const Terms& t) {
     const auto [begin, end] = t.one_ring(u);
     for (const Index* i = begin; i != end; ++i) add_star(*i);
     blocks.back() += t.D[static_cast<std::size_t>(u)];
-    for (auto k = first; k < last; ++k) position[static_cast<std::size_t>(free_vertex[static_cast<std::size_t>(row_columns[static_cast<std::size_t>(k)])])] = -1;
+    for (auto k = first; k < last; ++k)
+      position[static_cast<std::size_t>(
+          free_vertex[static_cast<std::size_t>(row_columns[static_cast<std::size_t>(k)])])] = -1;
     // Scatter: entry (3b + c, 3a + r) is H_{ur, wc} = block(u, w)(r, c).
     for (int r = 0; r < 3; ++r) {
       auto out = column_start[3 * static_cast<std::size_t>(a) + static_cast<std::size_t>(r)];
@@ -607,23 +619,27 @@ Vector FlowSystemSolver::Impl::factor_and_solve(const Terms& terms, const Vector
   report.seconds_factorization += seconds_since(start);
 
   start = Clock::now();
-  cholmod_dense* rhs = cholmod_l_allocate_dense(3 * static_cast<std::size_t>(m), 1, 3 * static_cast<std::size_t>(m), CHOLMOD_REAL, &common);
+  cholmod_dense* rhs = cholmod_l_allocate_dense(3 * static_cast<std::size_t>(m), 1, 3 * static_cast<std::size_t>(m),
+                                                CHOLMOD_REAL, &common);
   auto* rhs_values = static_cast<double*>(rhs->x);
   for (Index a = 0; a < m; ++a)
-    for (int c = 0; c < 3; ++c) rhs_values[3 * a + c] = b[3 * static_cast<Eigen::Index>(free_vertex[static_cast<std::size_t>(a)]) + c];
+    for (int c = 0; c < 3; ++c)
+      rhs_values[3 * a + c] = b[3 * static_cast<Eigen::Index>(free_vertex[static_cast<std::size_t>(a)]) + c];
   cholmod_dense* x = cholmod_l_solve(CHOLMOD_A, factor, rhs, &common);
   cholmod_l_free_dense(&rhs, &common);
   if (!x) throw std::runtime_error("vertex flow: the triangular solves failed");
   Vector d = Vector::Zero(b.size());
   const auto* x_values = static_cast<const double*>(x->x);
   for (Index a = 0; a < m; ++a)
-    for (int c = 0; c < 3; ++c) d[3 * static_cast<Eigen::Index>(free_vertex[static_cast<std::size_t>(a)]) + c] = x_values[3 * a + c];
+    for (int c = 0; c < 3; ++c)
+      d[3 * static_cast<Eigen::Index>(free_vertex[static_cast<std::size_t>(a)]) + c] = x_values[3 * a + c];
   cholmod_l_free_dense(&x, &common);
   report.seconds_solve += seconds_since(start);
   return d;
 }
 
-FlowSystemSolver::FlowSystemSolver(const Topology& topology, std::vector<char> fixed, LinearSolver kind, double tolerance)
+FlowSystemSolver::FlowSystemSolver(const Topology& topology, std::vector<char> fixed, LinearSolver kind,
+                                   double tolerance)
     : impl_(std::make_unique<Impl>(topology, std::move(fixed), kind, tolerance)) {
   if (!(tolerance > 0 && tolerance < 1)) throw std::invalid_argument("vertex flow: solver_tolerance must be in (0, 1)");
 }
@@ -652,7 +668,8 @@ Vertices FlowSystemSolver::solve(const FlowFrame& frame, const EnergyWeights& we
     report.seconds_factorization += seconds_since(start);
     start = Clock::now();
     const int budget = static_cast<int>(std::ceil(kBudgetPerSqrtVertex * std::sqrt(static_cast<double>(m))));
-    IterationResult result = cg.run(s.kind == LinearSolver::Iterative ? kIterationCapFactor * budget : budget, s.tolerance);
+    IterationResult result =
+        cg.run(s.kind == LinearSolver::Iterative ? kIterationCapFactor * budget : budget, s.tolerance);
     if (!result.converged && s.kind == LinearSolver::Automatic) {
       // Fall back to the factorisation if it fits; otherwise keep iterating.
       report.seconds_solve += seconds_since(start);

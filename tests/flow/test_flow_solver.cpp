@@ -9,9 +9,9 @@
 #include "vertexflow/io.h"
 #include "vertexflow/statistics.h"
 
-#include <Eigen/SparseCholesky>
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
+#include <Eigen/SparseCholesky>
 
 #include <cmath>
 
@@ -88,7 +88,9 @@ Vertices reference_solution(const Problem& p, const EnergyWeights& weights) {
   return Y;
 }
 
-double max_difference(const Vertices& a, const Vertices& b) { return (a - b).cwiseAbs().maxCoeff(); }
+double max_difference(const Vertices& a, const Vertices& b) {
+  return (a - b).cwiseAbs().maxCoeff();
+}
 
 TEST(FlowSolver, BothPathsMatchTheLeastSquaresReference) {
   // hemisphere: a boundary (fixed vertices); both fairness targets.
