@@ -188,6 +188,21 @@ TEST(FlowSolver, SameBytesForAnyThreadCount) {
   }
 }
 
+TEST(FlowSolver, VertexFlowSameBytesForAnyThreadCount) {
+  // bunny_uniform takes the iterative path under LinearSolver::Automatic.
+  const Mesh mesh = read_mesh(test::data_path("bunny_uniform.off"));
+  Vertices one, two;
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+    one = vertex_flow(mesh.V, mesh.F).V;
+  }
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+    two = vertex_flow(mesh.V, mesh.F).V;
+  }
+  EXPECT_EQ(one, two);
+}
+
 TEST(FlowSolver, ReusesItsAnalysisAcrossSolves) {
   // A second solve on moved positions (options.iterations > 1) reuses the ordering and the
   // symbolic factorisation; it must equal a fresh solver's result.
