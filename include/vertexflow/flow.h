@@ -28,6 +28,21 @@
 
 namespace vertexflow {
 
+/// How the flow's sparse linear system (the normal equations of flow_energy.h) is solved.
+enum class LinearSolver {
+  /// Conjugate gradients for meshes above a few thousand free vertices, falling back to the
+  /// direct factorisation when they have not converged within about the iterations the
+  /// factorisation would cost; the direct factorisation below that size. Deterministic: the
+  /// choice depends only on the mesh and the iteration count, never on timings.
+  Automatic,
+  /// Sparse Cholesky of the coupled 3n x 3n normal matrix (CHOLMOD). Exact to rounding, but its
+  /// time grows like n^1.5 and its memory like n log n: about 2 GB at 100k vertices.
+  Direct,
+  /// Conjugate gradients preconditioned by the normal matrix's 3x3 diagonal blocks, started
+  /// from the input positions, until the relative residual is below solver_tolerance.
+  Iterative,
+};
+
 struct FlowOptions {
   /// Weight of the distance term F_sd: the user's "strength" knob, inverted. Smaller lets the
   /// vertices move further (stronger enhancement); useful range about 0.2 (strong) to 50
@@ -76,6 +91,12 @@ struct FlowOptions {
   /// (only flipped and degenerate faces are repaired).
   double min_quality = 0.3;
   CurvatureOptions curvature;
+  /// Solver of the linear system; the choice does not change the energy that is minimised.
+  LinearSolver solver = LinearSolver::Automatic;
+  /// Iterative solver: stop when |H d - b| <= solver_tolerance |b| (normal equations, starting
+  /// residual b). 1e-9 keeps the result within about 1e-6 mean edge lengths of the exact
+  /// minimiser on the bundled meshes (tests/flow/test_flow_solver.cpp).
+  double solver_tolerance = 1e-9;
 };
 
 struct FlowReport {
@@ -87,6 +108,10 @@ struct FlowReport {
   Index limited_vertices = 0;          ///< vertices whose displacement the guard shortened
   Index fixed_vertices = 0;            ///< boundary, pinned and isolated vertices
   double seconds_curvature = 0, seconds_assembly = 0, seconds_solve = 0, seconds_projection = 0, seconds_guard = 0;
+  /// Direct: CHOLMOD's analysis and numeric factorisation; iterative: the preconditioner.
+  double seconds_factorization = 0;
+  LinearSolver solver_used = LinearSolver::Automatic;  ///< Direct or Iterative (the last solve)
+  int solver_iterations = 0;  ///< conjugate-gradient iterations of the last solve (0: direct only)
 };
 
 struct FlowResult {

@@ -69,7 +69,7 @@ std::vector<char> bad_faces(const GuardCriteria& criteria, const Vertices& after
 }
 
 // One solve: minimise the energy for positions X (normalised units), frozen curvature of X.
-Vertices solve_once(const Vertices& X, const Faces& F, const Topology& topology, const std::vector<char>& fixed,
+Vertices solve_once(const Vertices& X, const Faces& F, const Topology& topology, FlowSystemSolver& solver,
                     const FlowOptions& options, FlowReport& report) {
   const auto start = Clock::now();
   FlowFrame frame;
@@ -79,8 +79,8 @@ Vertices solve_once(const Vertices& X, const Faces& F, const Topology& topology,
   report.d = frame.d;
   report.seconds_curvature += seconds_since(start);
 
-  const Vertices Y = solve_flow_system(
-      topology, frame, {options.lambda, options.mu, options.epsilon, options.fairness_target}, fixed, report);
+  const Vertices Y =
+      solver.solve(frame, {options.lambda, options.mu, options.epsilon, options.fairness_target}, report);
   if (!Y.allFinite()) throw std::runtime_error("vertex flow: the solver diverged");
   return Y;
 }
@@ -146,8 +146,10 @@ FlowResult vertex_flow(const Vertices& V, const Faces& F, const FlowOptions& opt
   const Vertices input = (V.rowwise() - centroid) / scale;
 
   Vertices X = input;
+  // One solver for all rounds: the connectivity is fixed, so its ordering is computed once.
+  FlowSystemSolver solver(topology, fixed, options.solver, options.solver_tolerance);
   for (int round = 0; round < std::max(1, options.iterations); ++round) {
-    X = solve_once(X, F, topology, fixed, options, report);
+    X = solve_once(X, F, topology, solver, options, report);
     if (options.project_to_input) {
       const auto start = Clock::now();
       X = project_near_vertices(X, input, F, topology, features, fixed);

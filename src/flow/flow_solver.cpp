@@ -1,13 +1,53 @@
-// Assembles the flow's least-squares system and solves its normal equations with a sparse
-// Cholesky factorisation (CHOLMOD, supernodal).
+// Solves the flow's normal equations H d = b (flow_solver.h) by one of two methods.
+//
+// H = A^T A of flow_energy.h's rows is a sum of one-ring products. With K_i the curvature
+// tensor, G the 3n x 3n block operator (G x)_i = sum_{j in N(i)} (K_i + K_j)(x_i - x_j) (the g_i
+// of Eq. 16; symmetric), P_i = 1/|E| (T_i1 T_i1^T + T_i2 T_i2^T) the weighted tangent projector,
+// L the uniform Laplacian of Eq. 8, S = diag(mu mu_i / |V|) and D_i the 3x3 block of F_sd and
+// the pull:
+//   H = G P G + (L^T S L) (x) I_3 + D,     b = -(G P G P + L^T S (L P - R)),
+// R the fairness targets. So H x costs three passes over the one-rings (no matrix), and any
+// block of H is a short sum over the vertices whose one-rings contain both of its vertices.
+//
+// - Direct: H's 3x3 blocks (two-ring pattern) assembled from that sum; a fill-reducing
+//   ordering of the vertex graph (CHOLMOD: AMD, or METIS when AMD fills badly) expanded to the
+//   three coordinates, which gives the same fill as ordering the 3n graph at a ninth of the
+//   cost; CHOLMOD's supernodal Cholesky with one BLAS thread. The ordering and the symbolic
+//   factorisation depend only on the connectivity and are kept between solves.
+// - Iterative: conjugate gradients on the matrix-free H, started from the input (d = 0),
+//   preconditioned by the inverses of H's 3x3 diagonal blocks, which capture each vertex's
+//   anisotropy (stiff along the normal, soft in the tangent plane) exactly.
+//
+// Why these two and how the choice is made (measured on this project's meshes, docs/benchmarks.md):
+// the coupled factorisation costs about n^1.5 (3.1e9 flops at 9k vertices, 1.8e10 at 43k, an
+// estimated 2e12 and 16 GB at 1M), the iteration costs about n, and the iteration count stays
+// between 100 and 400 on smooth meshes of any size (bunny 9k: 106, armadillo 43k: 150,
+// armadillo subdivided to 1M: 320, to 1e-9) but reaches 1,300 where large flat regions leave
+// tangential motion to the bi-Laplacian of F_smo and the tiny pull (fandisk). Preconditioners
+// built on decoupled n x n factorisations (x, y, z, or per-vertex frames) and their two-level
+// combinations with Gauss-Seidel cost a factorisation each and still took 50-200 iterations,
+// so they lost to one of the two above everywhere.
+// The automatic rule is therefore competitive: below kDirectBelow free vertices factor
+// directly; otherwise iterate, and if the iteration has not converged after about the number
+// of iterations that the factorisation would take to run (kBudgetPerSqrtVertex * sqrt(free
+// vertices), calibrated on this machine) fall back to the factorisation when its predicted
+// memory fits, so the total is at most about twice the better of the two. It depends only on
+// counts, so the output bytes do not depend on timings or thread counts.
 #include "flow_solver.h"
 
-#include <Eigen/CholmodSupport>
-#include <Eigen/SparseCore>
-
+#include <cholmod.h>
 #include <dlfcn.h>
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_sort.h>
+
 #include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <numeric>
 #include <stdexcept>
 
 namespace vertexflow {
@@ -16,6 +56,49 @@ namespace {
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+using Matrix3 = Eigen::Matrix3d;
+using Vector3 = Eigen::Vector3d;
+using Vector = Eigen::VectorXd;  // 3 entries per vertex, x0 y0 z0 x1 ... (Vertices' layout)
+
+// Free vertices at or below this count are factored directly: a few milliseconds, exact, and
+// no iteration count to depend on (sphere_low, 589 vertices: 20 ms CPU direct, 1 ms iterating).
+constexpr Index kDirectBelow = 1000;
+// Iterations allowed before the fallback to the factorisation: the factorisation's time over
+// one iteration's time, both measured on bunny_uniform, armadillo-43k and amo (time ~ 4.5e-7
+// n^1.5 s against ~2.5e-8 n s on 2 cores, so the ratio is about 18 sqrt(n)).
+constexpr double kBudgetPerSqrtVertex = 18.0;
+// Without a fallback (the factorisation would not fit) the iteration stops at this many
+// times the budget.
+constexpr int kIterationCapFactor = 10;
+// The fallback is taken only when the predicted factor (9 x the vertex graph's fill) fits.
+constexpr double kMaxFactorBytes = 2.0 * 1024 * 1024 * 1024;
+
+template <class Body>
+void parallel_vertices(Index n, Body&& body) {
+  tbb::parallel_for(tbb::blocked_range<Index>(0, n, 1024), [&](const tbb::blocked_range<Index>& range) {
+    for (Index i = range.begin(); i != range.end(); ++i) body(i);
+  });
+}
+
+Eigen::Map<Vector3> at(Vector& v, Index i) {
+  return Eigen::Map<Vector3>(v.data() + 3 * static_cast<Eigen::Index>(i));
+}
+Eigen::Map<const Vector3> at(const Vector& v, Index i) {
+  return Eigen::Map<const Vector3>(v.data() + 3 * static_cast<Eigen::Index>(i));
+}
+
+// Dot product summed in fixed chunks, so that its rounding does not depend on the threads.
+double dot(const Vector& a, const Vector& b) {
+  constexpr Eigen::Index kChunk = 8192;
+  const Eigen::Index chunks = (a.size() + kChunk - 1) / kChunk;
+  std::vector<double> partial(static_cast<std::size_t>(chunks));
+  tbb::parallel_for(Eigen::Index{0}, chunks, [&](Eigen::Index k) {
+    const Eigen::Index begin = k * kChunk, length = std::min(kChunk, a.size() - begin);
+    partial[static_cast<std::size_t>(k)] = a.segment(begin, length).dot(b.segment(begin, length));
+  });
+  return std::accumulate(partial.begin(), partial.end(), 0.0);
 }
 
 // CHOLMOD's supernodal factorisation calls BLAS. Debian's default BLAS is the pthread build of
@@ -33,61 +116,598 @@ void use_single_threaded_blas() {
   }
 }
 
+// The per-vertex factors of H and b (see the top of this file), in normalised units, over the
+// vertices renumbered along a space-filling curve (`local` below): the operator gathers over
+// one-rings, and in a mesh's own order the neighbours of a vertex can be anywhere in memory
+// (the subdivided test mesh, amo.off). Measured: the iteration took 2-3x longer per vertex on
+// those meshes than on one whose file order is local (horse-48k).
+struct Terms {
+  Index n = 0;
+  std::vector<Index> original;          // local index -> mesh vertex
+  std::vector<Index> local;             // mesh vertex -> local index
+  std::vector<Index> ring_start, ring;  // one-rings in local indices
+  std::vector<char> fixed;
+  std::vector<Matrix3> K;  // K_i
+  std::vector<Matrix3> G;  // diagonal block of G: deg(i) K_i + sum_j K_j
+  std::vector<Matrix3> P;  // 1/|E| times the tangent projector
+  std::vector<Matrix3> D;  // F_sd and pull
+  std::vector<double> smooth, inv_degree;
+  std::vector<Vector3> rest;  // fairness target r_i
+
+  [[nodiscard]] std::pair<const Index*, const Index*> one_ring(Index i) const {
+    return {ring.data() + ring_start[static_cast<std::size_t>(i)],
+            ring.data() + ring_start[static_cast<std::size_t>(i) + 1]};
+  }
+};
+
+// Vertices sorted by the Morton code of their position (21 bits per axis), ties by index.
+std::vector<Index> space_filling_order(const Vertices& P) {
+  const Index n = static_cast<Index>(P.rows());
+  std::vector<std::pair<std::uint64_t, Index>> keys(static_cast<std::size_t>(n));
+  if (n == 0) return {};
+  const Eigen::RowVector3d low = P.colwise().minCoeff(), high = P.colwise().maxCoeff();
+  const double extent = std::max((high - low).maxCoeff(), 1e-300);
+  auto spread = [](std::uint64_t v) {  // 21 bits -> every third bit of 63
+    v &= 0x1fffffULL;
+    v = (v | v << 32) & 0x1f00000000ffffULL;
+    v = (v | v << 16) & 0x1f0000ff0000ffULL;
+    v = (v | v << 8) & 0x100f00f00f00f00fULL;
+    v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
+    v = (v | v << 2) & 0x1249249249249249ULL;
+    return v;
+  };
+  parallel_vertices(n, [&](Index i) {
+    std::uint64_t code = 0;
+    for (int c = 0; c < 3; ++c) {
+      const double unit = (P(i, c) - low[c]) / extent;
+      code |= spread(static_cast<std::uint64_t>(std::clamp(unit, 0.0, 1.0) * 2097151.0)) << c;
+    }
+    keys[static_cast<std::size_t>(i)] = {code, i};
+  });
+  tbb::parallel_sort(keys.begin(), keys.end());  // keys are unique, so the order is too
+  std::vector<Index> order(static_cast<std::size_t>(n));
+  for (std::size_t k = 0; k < keys.size(); ++k) order[k] = keys[k].second;
+  return order;
+}
+
+Terms make_terms(const Topology& topology, const std::vector<char>& fixed, const FlowFrame& frame,
+                 const EnergyWeights& weights, std::vector<Index> order) {
+  Terms t;
+  t.n = static_cast<Index>(frame.P.rows());
+  const auto n = static_cast<std::size_t>(t.n);
+  t.original = std::move(order);
+  t.local.resize(n);
+  for (std::size_t k = 0; k < n; ++k) t.local[static_cast<std::size_t>(t.original[k])] = static_cast<Index>(k);
+  t.ring_start.resize(n + 1);
+  t.ring_start[0] = 0;
+  for (std::size_t k = 0; k < n; ++k) t.ring_start[k + 1] = t.ring_start[k] + topology.valence(t.original[k]);
+  t.ring.resize(static_cast<std::size_t>(t.ring_start[n]));
+  t.fixed.resize(n);
+  parallel_vertices(t.n, [&](Index k) {
+    const Index v = t.original[static_cast<std::size_t>(k)];
+    t.fixed[static_cast<std::size_t>(k)] = fixed[static_cast<std::size_t>(v)];
+    const auto [begin, end] = topology.ring(v);
+    Index* out = t.ring.data() + t.ring_start[static_cast<std::size_t>(k)];
+    for (const Index* j = begin; j != end; ++j) *out++ = t.local[static_cast<std::size_t>(*j)];
+  });
+  t.K.resize(n);
+  t.G.resize(n);
+  t.P.resize(n);
+  t.D.resize(n);
+  t.smooth.resize(n);
+  t.inv_degree.resize(n);
+  t.rest.resize(n);
+  const Curvature& c = frame.curvature;
+  const double nv = std::max<double>(t.n, 1);
+  const double w_em = topology.num_edges() > 0 ? 1.0 / topology.num_edges() : 0.0;
+  const double w_sd = weights.lambda / nv, w_pull = weights.epsilon * weights.lambda / nv;
+  parallel_vertices(t.n, [&](Index k) {
+    const auto v = static_cast<std::size_t>(k);
+    const Index i = t.original[v];
+    const Vector3 t1 = c.T1.row(i).transpose(), t2 = c.T2.row(i).transpose(), normal = c.N.row(i).transpose();
+    t.K[v] = std::abs(c.k1[i]) * t1 * t1.transpose() + std::abs(c.k2[i]) * t2 * t2.transpose();
+    t.P[v] = w_em * (t1 * t1.transpose() + t2 * t2.transpose());
+    t.D[v] = w_sd * (distance_coefficient(frame.d, c.k1[i]) * t1 * t1.transpose() +
+                     distance_coefficient(frame.d, c.k2[i]) * t2 * t2.transpose() + normal * normal.transpose());
+    t.D[v].diagonal().array() += w_pull;
+    const Index degree = topology.valence(i);
+    t.inv_degree[v] = degree > 0 ? 1.0 / degree : 0.0;
+    t.smooth[v] = degree > 0 ? weights.mu * std::exp(-(std::abs(c.k1[i]) + std::abs(c.k2[i]))) / nv : 0.0;
+    t.rest[v].setZero();
+    if (weights.fairness_target == FairnessTarget::InputNormal && degree > 0) {
+      Vector3 mean = Vector3::Zero();
+      const auto [begin, end] = topology.ring(i);
+      for (const Index* j = begin; j != end; ++j) mean += frame.P.row(*j).transpose();  // mesh indices
+      const Vector3 umbrella = frame.P.row(i).transpose() - mean * t.inv_degree[v];
+      t.rest[v] = umbrella.dot(normal) * normal;
+    }
+  });
+  parallel_vertices(t.n, [&](Index i) {
+    const auto [begin, end] = t.one_ring(i);
+    Matrix3 sum = static_cast<double>(end - begin) * t.K[static_cast<std::size_t>(i)];
+    for (const Index* j = begin; j != end; ++j) sum += t.K[static_cast<std::size_t>(*j)];
+    t.G[static_cast<std::size_t>(i)] = sum;
+  });
+  return t;
+}
+
+// A vector over mesh vertices (3 per vertex) in local order, and back.
+Vector to_local(const Terms& t, const double* x) {
+  Vector out(3 * static_cast<Eigen::Index>(t.n));
+  parallel_vertices(t.n, [&](Index k) {
+    out.segment<3>(3 * static_cast<Eigen::Index>(k)) =
+        Eigen::Map<const Vector3>(x + 3 * static_cast<std::ptrdiff_t>(t.original[static_cast<std::size_t>(k)]));
+  });
+  return out;
+}
+void add_from_local(const Terms& t, const Vector& x, double* out) {
+  parallel_vertices(t.n, [&](Index k) {
+    Eigen::Map<Vector3>(out + 3 * static_cast<std::ptrdiff_t>(t.original[static_cast<std::size_t>(k)])) +=
+        x.segment<3>(3 * static_cast<Eigen::Index>(k));
+  });
+}
+
+// The block G_iu of G for u in the star (one-ring and itself) of i.
+Matrix3 g_block(const Terms& t, Index i, Index u) {
+  return i == u ? t.G[static_cast<std::size_t>(i)]
+                : Matrix3(-(t.K[static_cast<std::size_t>(i)] + t.K[static_cast<std::size_t>(u)]));
+}
+// The entry L_iu of the Laplacian.
+double l_entry(const Terms& t, Index i, Index u) {
+  return i == u ? 1.0 : -t.inv_degree[static_cast<std::size_t>(i)];
+}
+
+// H x (or, with with_d false and with_rest true, the part of H x - b that does not depend on D)
+// without forming H. Rows of fixed vertices are set to zero.
+class Operator {
+ public:
+  explicit Operator(const Terms& terms) : t_(terms) {
+    const Eigen::Index size = 3 * static_cast<Eigen::Index>(t_.n);
+    kx_.resize(size);
+    q_.resize(size);
+    kq_.resize(size);
+    r_.resize(size);
+    rd_.resize(size);
+  }
+
+  void apply(const Vector& x, Vector& y, bool with_d, bool with_rest) {
+    parallel_vertices(t_.n, [&](Index i) { at(kx_, i) = t_.K[static_cast<std::size_t>(i)] * at(x, i); });
+    // q = P G x and r = S (L x - R): the rows of F_tan and F_smo, weighted.
+    parallel_vertices(t_.n, [&](Index i) {
+      const auto v = static_cast<std::size_t>(i);
+      const auto [begin, end] = t_.one_ring(i);
+      Vector3 sum_x = Vector3::Zero(), sum_kx = Vector3::Zero();
+      for (const Index* j = begin; j != end; ++j) {
+        sum_x += at(x, *j);
+        sum_kx += at(kx_, *j);
+      }
+      const Vector3 xi = at(x, i);
+      const Vector3 g = t_.G[v] * xi - t_.K[v] * sum_x - sum_kx;
+      const Vector3 q = t_.P[v] * g;
+      at(q_, i) = q;
+      at(kq_, i) = t_.K[v] * q;
+      Vector3 laplacian = xi - t_.inv_degree[v] * sum_x;
+      if (with_rest) laplacian -= t_.rest[v];
+      at(r_, i) = t_.smooth[v] * laplacian;
+      at(rd_, i) = t_.smooth[v] * t_.inv_degree[v] * laplacian;
+    });
+    // y = G q + L^T r (+ D x).
+    parallel_vertices(t_.n, [&](Index u) {
+      const auto v = static_cast<std::size_t>(u);
+      if (t_.fixed[v]) {
+        at(y, u).setZero();
+        return;
+      }
+      const auto [begin, end] = t_.one_ring(u);
+      Vector3 sum_q = Vector3::Zero(), sum_kq = Vector3::Zero(), sum_rd = Vector3::Zero();
+      for (const Index* j = begin; j != end; ++j) {
+        sum_q += at(q_, *j);
+        sum_kq += at(kq_, *j);
+        sum_rd += at(rd_, *j);
+      }
+      Vector3 out = t_.G[v] * at(q_, u) - t_.K[v] * sum_q - sum_kq + at(r_, u) - sum_rd;
+      if (with_d) out += t_.D[v] * at(x, u);
+      at(y, u) = out;
+    });
+  }
+
+ private:
+  const Terms& t_;
+  Vector kx_, q_, kq_, r_, rd_;
+};
+
+// The 3x3 diagonal block of H at free vertex u: sum over the star of u of G_iu P_i G_iu and
+// S_i L_iu^2, plus D_u.
+Matrix3 diagonal_block(const Terms& t, Index u) {
+  Matrix3 block = t.D[static_cast<std::size_t>(u)];
+  double laplacian = 0;
+  auto add = [&](Index i) {
+    const Matrix3 g = g_block(t, i, u);
+    block.noalias() += g * t.P[static_cast<std::size_t>(i)] * g;
+    laplacian += t.smooth[static_cast<std::size_t>(i)] * l_entry(t, i, u) * l_entry(t, i, u);
+  };
+  add(u);
+  const auto [begin, end] = t.one_ring(u);
+  for (const Index* i = begin; i != end; ++i) add(*i);
+  block.diagonal().array() += laplacian;
+  return block;
+}
+
+struct IterationResult {
+  int iterations = 0;
+  bool converged = false;
+};
+
+// Preconditioned conjugate gradients from d = 0 (the input positions). Each run() continues
+// for at most max_iterations, stopping when |r| <= tolerance |b|.
+class ConjugateGradients {
+ public:
+  ConjugateGradients(const Terms& terms, Operator& op, const Vector& b) : t_(terms), op_(op) {
+    inverse_.resize(static_cast<std::size_t>(t_.n));
+    parallel_vertices(t_.n, [&](Index u) {
+      const auto v = static_cast<std::size_t>(u);
+      inverse_[v] = t_.fixed[v] ? Matrix3::Zero() : Matrix3(diagonal_block(t_, u).inverse());
+    });
+    d_.setZero(b.size());
+    r_ = b;
+    z_.resize(b.size());
+    p_.resize(b.size());
+    hp_.resize(b.size());
+    precondition();
+    p_ = z_;
+    rz_ = dot(r_, z_);
+    b_norm_ = std::sqrt(dot(b, b));
+  }
+
+  IterationResult run(int max_iterations, double tolerance) {
+    IterationResult result;
+    const double target = tolerance * b_norm_;
+    if (std::sqrt(dot(r_, r_)) <= target) {
+      result.converged = true;
+      return result;
+    }
+    while (result.iterations < max_iterations) {
+      op_.apply(p_, hp_, true, false);
+      const double curvature = dot(p_, hp_);
+      if (!(curvature > 0)) break;  // H is positive definite; only rounding at convergence gets here
+      const double alpha = rz_ / curvature;
+      tbb::parallel_for(Index{0}, t_.n, [&](Index i) {
+        at(d_, i) += alpha * at(p_, i);
+        at(r_, i) -= alpha * at(hp_, i);
+      });
+      ++result.iterations;
+      ++total_iterations_;
+      if (std::sqrt(dot(r_, r_)) <= target) {
+        result.converged = true;
+        break;
+      }
+      precondition();
+      const double rz = dot(r_, z_);
+      const double beta = rz / rz_;
+      rz_ = rz;
+      tbb::parallel_for(Index{0}, t_.n, [&](Index i) { at(p_, i) = at(z_, i) + beta * at(p_, i); });
+    }
+    return result;
+  }
+
+  const Vector& solution() const { return d_; }
+  int total_iterations() const { return total_iterations_; }
+
+ private:
+  void precondition() {
+    tbb::parallel_for(Index{0}, t_.n, [&](Index i) { at(z_, i) = inverse_[static_cast<std::size_t>(i)] * at(r_, i); });
+  }
+
+  const Terms& t_;
+  Operator& op_;
+  std::vector<Matrix3> inverse_;
+  Vector d_, r_, z_, p_, hp_;
+  double rz_ = 0, b_norm_ = 0;
+  int total_iterations_ = 0;
+};
+
 }  // namespace
 
-Vertices solve_flow_system(const Topology& topology, const FlowFrame& frame, const EnergyWeights& weights,
-                           const std::vector<char>& fixed, FlowReport& report) {
-  const Index n = static_cast<Index>(frame.P.rows());
-  auto start = Clock::now();
-  const LeastSquaresSystem system = assemble_flow_system(topology, frame, weights);
-  // Eliminate the fixed vertices: their columns move to the right-hand side.
-  std::vector<Index> column(3 * static_cast<std::size_t>(n), -1);
-  Index free_columns = 0;
-  for (Index i = 0; i < n; ++i) {
-    if (fixed[static_cast<std::size_t>(i)]) continue;
-    for (int k = 0; k < 3; ++k) column[3 * static_cast<std::size_t>(i) + static_cast<std::size_t>(k)] = free_columns++;
+struct FlowSystemSolver::Impl {
+  const Topology& topology;
+  std::vector<char> fixed;
+  LinearSolver kind;
+  double tolerance;
+  // Local numbering (Terms), chosen at the first solve and kept: the pattern and the ordering
+  // below are in it.
+  std::vector<Index> order;
+  std::vector<Index> free_index;   // local index -> free index, -1 for fixed vertices
+  std::vector<Index> free_vertex;  // free index -> local index
+  // Two-ring pattern of H over the free vertices, lower half by rows (= upper half by
+  // columns): row a holds the free indices b <= a.
+  std::vector<std::int64_t> row_start;
+  std::vector<Index> row_columns;
+  bool pattern_built = false;
+  double scalar_factor_entries = -1;  // CHOLMOD's predicted fill of the vertex graph
+  std::vector<SuiteSparse_long> vertex_permutation;
+  cholmod_common common{};
+  cholmod_factor* factor = nullptr;
+
+  Impl(const Topology& t, std::vector<char> f, LinearSolver k, double tol)
+      : topology(t), fixed(std::move(f)), kind(k), tolerance(tol) {
+    cholmod_l_start(&common);
+    common.supernodal = CHOLMOD_SUPERNODAL;
   }
-  Eigen::VectorXd rhs = system.b;
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(static_cast<std::size_t>(system.A.nonZeros()));
-  for (Eigen::Index r = 0; r < system.A.outerSize(); ++r) {
-    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(system.A, r); it; ++it) {
-      const Index c = column[static_cast<std::size_t>(it.col())];
-      if (c >= 0)
-        triplets.emplace_back(static_cast<Index>(r), c, it.value());
-      else
-        rhs[r] -= it.value() * frame.P(it.col() / 3, it.col() % 3);
+  ~Impl() {
+    if (factor) cholmod_l_free_factor(&factor, &common);
+    cholmod_l_finish(&common);
+  }
+  Impl(const Impl&) = delete;
+  Impl& operator=(const Impl&) = delete;
+
+  [[nodiscard]] Index num_free() const { return static_cast<Index>(std::count(fixed.begin(), fixed.end(), 0)); }
+
+  void number_vertices(const Vertices& P) {
+    if (!order.empty() || P.rows() == 0) return;
+    order = space_filling_order(P);
+    free_index.assign(order.size(), -1);
+    for (std::size_t k = 0; k < order.size(); ++k) {
+      if (fixed[static_cast<std::size_t>(order[k])]) continue;
+      free_index[k] = static_cast<Index>(free_vertex.size());
+      free_vertex.push_back(static_cast<Index>(k));
     }
   }
-  Eigen::SparseMatrix<double> A_free(system.A.rows(), free_columns);
-  A_free.setFromTriplets(triplets.begin(), triplets.end());
-  const Eigen::SparseMatrix<double> normal_matrix = Eigen::SparseMatrix<double>(A_free.transpose()) * A_free;
-  const Eigen::VectorXd normal_rhs = A_free.transpose() * rhs;
+  void build_pattern(const Terms& terms);
+  void order_vertices(const Terms& terms);
+  cholmod_sparse* assemble(const Terms& terms);
+  Vector factor_and_solve(const Terms& terms, const Vector& b, FlowReport& report);
+};
+
+// Column a of the upper half holds the free vertices b <= a that share a star with a.
+void FlowSystemSolver::Impl::build_pattern(const Terms& t) {
+  if (pattern_built) return;
+  const Index m = num_free(), n = static_cast<Index>(fixed.size());
+  std::vector<std::vector<Index>> rows(static_cast<std::size_t>(m));
+  tbb::enumerable_thread_specific<std::vector<Index>> marks(
+      [n] { return std::vector<Index>(static_cast<std::size_t>(n), -1); });
+  parallel_vertices(m, [&](Index a) {
+    std::vector<Index>& mark = marks.local();
+    std::vector<Index>& row = rows[static_cast<std::size_t>(a)];
+    const Index u = free_vertex[static_cast<std::size_t>(a)];
+    auto visit = [&](Index w) {
+      const Index b = free_index[static_cast<std::size_t>(w)];
+      if (b < 0 || b > a || mark[static_cast<std::size_t>(w)] == a) return;
+      mark[static_cast<std::size_t>(w)] = a;
+      row.push_back(b);
+    };
+    auto visit_star = [&](Index i) {
+      visit(i);
+      const auto [begin, end] = t.one_ring(i);
+      for (const Index* j = begin; j != end; ++j) visit(*j);
+    };
+    visit_star(u);
+    const auto [begin, end] = t.one_ring(u);
+    for (const Index* i = begin; i != end; ++i) visit_star(*i);
+    std::sort(row.begin(), row.end());
+  });
+  row_start.assign(static_cast<std::size_t>(m) + 1, 0);
+  for (Index a = 0; a < m; ++a)
+    row_start[static_cast<std::size_t>(a) + 1] =
+        row_start[static_cast<std::size_t>(a)] + static_cast<std::int64_t>(rows[static_cast<std::size_t>(a)].size());
+  row_columns.resize(static_cast<std::size_t>(row_start.back()));
+  parallel_vertices(m, [&](Index a) {
+    const auto& row = rows[static_cast<std::size_t>(a)];
+    std::copy(row.begin(), row.end(), row_columns.begin() + row_start[static_cast<std::size_t>(a)]);
+  });
+  pattern_built = true;
+}
+
+// A fill-reducing ordering of the free vertex graph (CHOLMOD's default choice: AMD, and METIS
+// too when AMD's fill is large), and its predicted fill.
+void FlowSystemSolver::Impl::order_vertices(const Terms& terms) {
+  if (!vertex_permutation.empty() || num_free() == 0) return;
+  build_pattern(terms);
+  const Index m = num_free();
+  cholmod_sparse* pattern = cholmod_l_allocate_sparse(static_cast<std::size_t>(m), static_cast<std::size_t>(m),
+                                                      row_columns.size(), 1, 1, 1, CHOLMOD_PATTERN, &common);
+  auto* p = static_cast<SuiteSparse_long*>(pattern->p);
+  auto* i = static_cast<SuiteSparse_long*>(pattern->i);
+  std::copy(row_start.begin(), row_start.end(), p);
+  std::copy(row_columns.begin(), row_columns.end(), i);
+  common.nmethods = 0;
+  common.postorder = 1;
+  cholmod_factor* symbolic = cholmod_l_analyze(pattern, &common);
+  if (!symbolic) {
+    cholmod_l_free_sparse(&pattern, &common);
+    throw std::runtime_error("vertex flow: CHOLMOD could not order the vertex graph");
+  }
+  scalar_factor_entries = common.lnz;
+  const auto* perm = static_cast<const SuiteSparse_long*>(symbolic->Perm);
+  vertex_permutation.assign(perm, perm + m);
+  cholmod_l_free_factor(&symbolic, &common);
+  cholmod_l_free_sparse(&pattern, &common);
+}
+
+// H over the free vertices, upper half by columns, with 3x3 blocks expanded: column 3a + r
+// holds rows 3b + c for b < a, and b = a with c <= r.
+cholmod_sparse* FlowSystemSolver::Impl::assemble(const Terms& t) {
+  build_pattern(t);
+  const Index m = num_free(), n = static_cast<Index>(fixed.size());
+  std::vector<SuiteSparse_long> column_start(3 * static_cast<std::size_t>(m) + 1, 0);
+  for (Index a = 0; a < m; ++a) {
+    const auto off_diagonal =
+        3 * (row_start[static_cast<std::size_t>(a) + 1] - row_start[static_cast<std::size_t>(a)] - 1);
+    for (int r = 0; r < 3; ++r) {
+      const std::size_t column = 3 * static_cast<std::size_t>(a) + static_cast<std::size_t>(r);
+      column_start[column + 1] = column_start[column] + off_diagonal + r + 1;
+    }
+  }
+  const auto entries = static_cast<std::size_t>(column_start.back());
+  cholmod_sparse* A = cholmod_l_allocate_sparse(3 * static_cast<std::size_t>(m), 3 * static_cast<std::size_t>(m),
+                                                entries, 1, 1, 1, CHOLMOD_REAL, &common);
+  if (!A) throw std::runtime_error("vertex flow: out of memory for the normal matrix");
+  std::copy(column_start.begin(), column_start.end(), static_cast<SuiteSparse_long*>(A->p));
+  auto* rows = static_cast<SuiteSparse_long*>(A->i);
+  auto* values = static_cast<double*>(A->x);
+  tbb::enumerable_thread_specific<std::vector<std::int64_t>> positions(
+      [n] { return std::vector<std::int64_t>(static_cast<std::size_t>(n), -1); });
+  tbb::enumerable_thread_specific<std::vector<Matrix3>> scratch;
+  parallel_vertices(m, [&](Index a) {
+    std::vector<std::int64_t>& position = positions.local();
+    std::vector<Matrix3>& blocks = scratch.local();
+    const auto first = row_start[static_cast<std::size_t>(a)], last = row_start[static_cast<std::size_t>(a) + 1];
+    blocks.assign(static_cast<std::size_t>(last - first), Matrix3::Zero());
+    for (auto k = first; k < last; ++k)
+      position[static_cast<std::size_t>(
+          free_vertex[static_cast<std::size_t>(row_columns[static_cast<std::size_t>(k)])])] = k - first;
+    const Index u = free_vertex[static_cast<std::size_t>(a)];
+    // Block (u, w) = sum over i whose star holds u and w of G_iu P_i G_iw + S_i L_iu L_iw I.
+    auto add_star = [&](Index i) {
+      const Matrix3 left = g_block(t, i, u) * t.P[static_cast<std::size_t>(i)];
+      const double l_u = t.smooth[static_cast<std::size_t>(i)] * l_entry(t, i, u);
+      auto add = [&](Index w) {
+        const std::int64_t k = position[static_cast<std::size_t>(w)];
+        if (k < 0) return;  // fixed, or w > u
+        Matrix3& block = blocks[static_cast<std::size_t>(k)];
+        block.noalias() += left * g_block(t, i, w);
+        block.diagonal().array() += l_u * l_entry(t, i, w);
+      };
+      add(i);
+      const auto [begin, end] = t.one_ring(i);
+      for (const Index* j = begin; j != end; ++j) add(*j);
+    };
+    add_star(u);
+    const auto [begin, end] = t.one_ring(u);
+    for (const Index* i = begin; i != end; ++i) add_star(*i);
+    blocks.back() += t.D[static_cast<std::size_t>(u)];
+    for (auto k = first; k < last; ++k)
+      position[static_cast<std::size_t>(
+          free_vertex[static_cast<std::size_t>(row_columns[static_cast<std::size_t>(k)])])] = -1;
+    // Scatter: entry (3b + c, 3a + r) is H_{ur, wc} = block(u, w)(r, c).
+    for (int r = 0; r < 3; ++r) {
+      auto out = column_start[3 * static_cast<std::size_t>(a) + static_cast<std::size_t>(r)];
+      for (auto k = first; k < last; ++k) {
+        const Index b = row_columns[static_cast<std::size_t>(k)];
+        const int columns = b == a ? r + 1 : 3;
+        for (int c = 0; c < columns; ++c) {
+          rows[out] = 3 * static_cast<SuiteSparse_long>(b) + c;
+          values[out] = blocks[static_cast<std::size_t>(k - first)](r, c);
+          ++out;
+        }
+      }
+    }
+  });
+  return A;
+}
+
+Vector FlowSystemSolver::Impl::factor_and_solve(const Terms& terms, const Vector& b, FlowReport& report) {
+  const Index m = num_free();
+  auto start = Clock::now();
+  order_vertices(terms);
+  cholmod_sparse* A = assemble(terms);
   report.seconds_assembly += seconds_since(start);
 
   start = Clock::now();
-  // Sparse Cholesky of the normal equations (CHOLMOD, supernodal). Robust whatever the
-  // conditioning; the coupled 3n x 3n factor fills in, so very large meshes want the
-  // preconditioned iterative path planned in the flow issue.
-  Eigen::VectorXd solution(free_columns);
-  if (free_columns > 0) {
-    use_single_threaded_blas();
-    Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> cholesky;
-    cholesky.compute(normal_matrix);
-    if (cholesky.info() != Eigen::Success)
-      throw std::runtime_error("vertex flow: the normal matrix is not positive definite");
-    solution = cholesky.solve(normal_rhs);
-    report.solver_error = (normal_matrix * solution - normal_rhs).norm() / std::max(normal_rhs.norm(), 1e-300);
+  use_single_threaded_blas();
+  if (!factor) {
+    std::vector<SuiteSparse_long> permutation(3 * static_cast<std::size_t>(m));
+    for (std::size_t k = 0; k < vertex_permutation.size(); ++k)
+      for (int c = 0; c < 3; ++c) permutation[3 * k + static_cast<std::size_t>(c)] = 3 * vertex_permutation[k] + c;
+    common.nmethods = 1;
+    common.method[0].ordering = CHOLMOD_GIVEN;
+    common.postorder = 1;
+    factor = cholmod_l_analyze_p(A, permutation.data(), nullptr, 0, &common);
   }
-  Vertices Y = frame.P;
-  for (Index i = 0; i < n; ++i) {
-    for (int k = 0; k < 3; ++k) {
-      const Index c = column[3 * static_cast<std::size_t>(i) + static_cast<std::size_t>(k)];
-      if (c >= 0) Y(i, k) = solution[c];
+  const bool ok = factor && cholmod_l_factorize(A, factor, &common) && common.status == CHOLMOD_OK;
+  cholmod_l_free_sparse(&A, &common);
+  if (!ok) throw std::runtime_error("vertex flow: the normal matrix is not positive definite");
+  report.seconds_factorization += seconds_since(start);
+
+  start = Clock::now();
+  cholmod_dense* rhs = cholmod_l_allocate_dense(3 * static_cast<std::size_t>(m), 1, 3 * static_cast<std::size_t>(m),
+                                                CHOLMOD_REAL, &common);
+  auto* rhs_values = static_cast<double*>(rhs->x);
+  for (Index a = 0; a < m; ++a)
+    for (int c = 0; c < 3; ++c)
+      rhs_values[3 * a + c] = b[3 * static_cast<Eigen::Index>(free_vertex[static_cast<std::size_t>(a)]) + c];
+  cholmod_dense* x = cholmod_l_solve(CHOLMOD_A, factor, rhs, &common);
+  cholmod_l_free_dense(&rhs, &common);
+  if (!x) throw std::runtime_error("vertex flow: the triangular solves failed");
+  Vector d = Vector::Zero(b.size());
+  const auto* x_values = static_cast<const double*>(x->x);
+  for (Index a = 0; a < m; ++a)
+    for (int c = 0; c < 3; ++c)
+      d[3 * static_cast<Eigen::Index>(free_vertex[static_cast<std::size_t>(a)]) + c] = x_values[3 * a + c];
+  cholmod_l_free_dense(&x, &common);
+  report.seconds_solve += seconds_since(start);
+  return d;
+}
+
+FlowSystemSolver::FlowSystemSolver(const Topology& topology, std::vector<char> fixed, LinearSolver kind,
+                                   double tolerance)
+    : impl_(std::make_unique<Impl>(topology, std::move(fixed), kind, tolerance)) {
+  if (!(tolerance > 0 && tolerance < 1)) throw std::invalid_argument("vertex flow: solver_tolerance must be in (0, 1)");
+}
+
+FlowSystemSolver::~FlowSystemSolver() = default;
+
+Vertices FlowSystemSolver::solve(const FlowFrame& frame, const EnergyWeights& weights, FlowReport& report) {
+  Impl& s = *impl_;
+  const Index m = s.num_free();
+  auto start = Clock::now();
+  s.number_vertices(frame.P);
+  const Terms terms = make_terms(s.topology, s.fixed, frame, weights, s.order);
+  Operator op(terms);
+  // b = -(H P - D P) with the fairness targets: the negative gradient at d = 0.
+  Vector b(3 * static_cast<Eigen::Index>(terms.n));
+  op.apply(to_local(terms, frame.P.data()), b, false, true);
+  b = -b;
+  report.seconds_assembly += seconds_since(start);
+
+  bool direct = s.kind == LinearSolver::Direct || (s.kind == LinearSolver::Automatic && m <= kDirectBelow);
+  Vector d;
+  report.solver_iterations = 0;
+  if (!direct && m > 0) {
+    start = Clock::now();
+    ConjugateGradients cg(terms, op, b);
+    report.seconds_factorization += seconds_since(start);
+    start = Clock::now();
+    const int budget = static_cast<int>(std::ceil(kBudgetPerSqrtVertex * std::sqrt(static_cast<double>(m))));
+    IterationResult result =
+        cg.run(s.kind == LinearSolver::Iterative ? kIterationCapFactor * budget : budget, s.tolerance);
+    if (!result.converged && s.kind == LinearSolver::Automatic) {
+      // Fall back to the factorisation if it fits; otherwise keep iterating.
+      report.seconds_solve += seconds_since(start);
+      start = Clock::now();
+      s.order_vertices(terms);
+      report.seconds_factorization += seconds_since(start);
+      start = Clock::now();
+      if (9.0 * s.scalar_factor_entries * sizeof(double) <= kMaxFactorBytes) {
+        direct = true;
+      } else {
+        result = cg.run((kIterationCapFactor - 1) * budget, s.tolerance);
+      }
     }
+    report.seconds_solve += seconds_since(start);
+    report.solver_iterations = cg.total_iterations();
+    if (!direct) d = cg.solution();
   }
+  if (direct && m > 0) d = s.factor_and_solve(terms, b, report);
+  if (m == 0) d = Vector::Zero(b.size());
+  report.solver_used = direct ? LinearSolver::Direct : LinearSolver::Iterative;
+
+  // The relative residual of the normal equations, independent of the method.
+  start = Clock::now();
+  Vector residual(b.size());
+  op.apply(d, residual, true, false);
+  residual -= b;
+  const double b_norm = std::sqrt(dot(b, b));
+  report.solver_error = b_norm > 0 ? std::sqrt(dot(residual, residual)) / b_norm : 0.0;
+  Vertices Y = frame.P;
+  add_from_local(terms, d, Y.data());
   report.seconds_solve += seconds_since(start);
   return Y;
+}
+
+Vertices solve_flow_system(const Topology& topology, const FlowFrame& frame, const EnergyWeights& weights,
+                           const std::vector<char>& fixed, FlowReport& report) {
+  FlowSystemSolver solver(topology, fixed);
+  return solver.solve(frame, weights, report);
 }
 
 }  // namespace vertexflow

@@ -1,0 +1,238 @@
+// The flow's linear solvers (src/flow/flow_solver.h): the direct factorisation against an
+// independent reference (A^T A of the assembled least-squares rows, Eigen's LDLT), the
+// iterative path against the direct one on real meshes (same minimiser, same energy), the
+// automatic choice and its fallback, and identical bytes for any thread count.
+#include "shapes.h"
+#include "test_support.h"
+
+#include "flow_solver.h"
+#include "vertexflow/io.h"
+#include "vertexflow/statistics.h"
+
+#include <gtest/gtest.h>
+#include <tbb/global_control.h>
+#include <Eigen/SparseCholesky>
+
+#include <cmath>
+
+namespace vertexflow {
+namespace {
+
+// The problem vertex_flow solves, without its guard: scaled to mean edge length 1, boundary
+// vertices fixed.
+struct Problem {
+  Mesh mesh;
+  Topology topology;
+  FlowFrame frame;
+  std::vector<char> fixed;
+};
+
+Problem make_problem(Mesh mesh) {
+  Problem p;
+  p.mesh = std::move(mesh);
+  p.topology = build_topology(p.mesh.F, p.mesh.num_vertices());
+  p.frame.P = (p.mesh.V.rowwise() - p.mesh.V.colwise().mean()) / mean_edge_length(p.mesh.V, p.topology);
+  p.frame.curvature = principal_curvatures(p.frame.P, p.mesh.F, p.topology);
+  std::vector<double> k(static_cast<std::size_t>(p.mesh.num_vertices()));
+  for (Index i = 0; i < p.mesh.num_vertices(); ++i)
+    k[static_cast<std::size_t>(i)] = std::max(std::abs(p.frame.curvature.k1[i]), std::abs(p.frame.curvature.k2[i]));
+  p.frame.d = 1.0 / percentile(k, 99.0);
+  p.fixed.assign(static_cast<std::size_t>(p.mesh.num_vertices()), 0);
+  for (Index i = 0; i < p.mesh.num_vertices(); ++i)
+    p.fixed[static_cast<std::size_t>(i)] = p.topology.is_boundary_vertex[static_cast<std::size_t>(i)] ? 1 : 0;
+  return p;
+}
+
+Vertices solve(const Problem& p, LinearSolver kind, const EnergyWeights& weights = {}, FlowReport* report = nullptr,
+               double tolerance = 1e-9) {
+  FlowReport local;
+  FlowSystemSolver solver(p.topology, p.fixed, kind, tolerance);
+  Vertices Y = solver.solve(p.frame, weights, report ? *report : local);
+  return Y;
+}
+
+// Minimiser of ||A x - b||^2 over the free coordinates, from the rows of flow_energy.h:
+// columns of fixed vertices moved to the right-hand side, then A^T A x = A^T b by LDLT.
+Vertices reference_solution(const Problem& p, const EnergyWeights& weights) {
+  const LeastSquaresSystem system = assemble_flow_system(p.topology, p.frame, weights);
+  const Index n = p.mesh.num_vertices();
+  std::vector<Index> column(3 * static_cast<std::size_t>(n), -1);
+  Index free_columns = 0;
+  for (Index i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k)
+      if (!p.fixed[static_cast<std::size_t>(i)]) column[3 * static_cast<std::size_t>(i) + k] = free_columns++;
+  Eigen::VectorXd rhs = system.b;
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (Eigen::Index r = 0; r < system.A.outerSize(); ++r) {
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(system.A, r); it; ++it) {
+      const Index c = column[static_cast<std::size_t>(it.col())];
+      if (c >= 0) {
+        triplets.emplace_back(static_cast<Index>(r), c, it.value());
+      } else {
+        rhs[r] -= it.value() * p.frame.P(it.col() / 3, it.col() % 3);
+      }
+    }
+  }
+  Eigen::SparseMatrix<double> A(system.A.rows(), free_columns);
+  A.setFromTriplets(triplets.begin(), triplets.end());
+  const Eigen::SparseMatrix<double> AtA = Eigen::SparseMatrix<double>(A.transpose()) * A;
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(AtA);
+  EXPECT_EQ(ldlt.info(), Eigen::Success);
+  const Eigen::VectorXd x = ldlt.solve(A.transpose() * rhs);
+  Vertices Y = p.frame.P;
+  for (Index i = 0; i < n; ++i)
+    for (int k = 0; k < 3; ++k) {
+      const Index c = column[3 * static_cast<std::size_t>(i) + k];
+      if (c >= 0) Y(i, k) = x[c];
+    }
+  return Y;
+}
+
+double max_difference(const Vertices& a, const Vertices& b) {
+  return (a - b).cwiseAbs().maxCoeff();
+}
+
+TEST(FlowSolver, BothPathsMatchTheLeastSquaresReference) {
+  // hemisphere: a boundary (fixed vertices); both fairness targets.
+  const Problem p = make_problem(read_mesh(test::data_path("hemisphere.off")));
+  for (const FairnessTarget target : {FairnessTarget::InputNormal, FairnessTarget::Zero}) {
+    EnergyWeights weights;
+    weights.fairness_target = target;
+    const Vertices reference = reference_solution(p, weights);
+    ASSERT_GT(max_difference(reference, p.frame.P), 0.01);  // the solve moves vertices
+    // Units: mean edge lengths. The direct path is exact up to rounding.
+    EXPECT_LT(max_difference(solve(p, LinearSolver::Direct, weights), reference), 1e-9);
+    EXPECT_LT(max_difference(solve(p, LinearSolver::Iterative, weights), reference), 1e-6);
+  }
+}
+
+// Direct and iterative give the same minimiser and the same energy on real meshes, including a
+// CAD part whose flat faces make the iteration slow (fandisk), a scan with a boundary
+// (camelhead) and a small lambda (stronger flow, weaker distance term).
+struct AgreeCase {
+  const char* file;
+  double lambda;
+};
+
+class FlowSolverAgree : public ::testing::TestWithParam<AgreeCase> {};
+
+TEST_P(FlowSolverAgree, SameMinimiserAndEnergy) {
+  const Problem p = make_problem(read_mesh(test::data_path(GetParam().file)));
+  EnergyWeights weights;
+  weights.lambda = GetParam().lambda;
+  FlowReport direct_report, iterative_report;
+  const Vertices direct = solve(p, LinearSolver::Direct, weights, &direct_report);
+  const Vertices iterative = solve(p, LinearSolver::Iterative, weights, &iterative_report);
+  EXPECT_EQ(direct_report.solver_used, LinearSolver::Direct);
+  EXPECT_EQ(iterative_report.solver_used, LinearSolver::Iterative);
+  EXPECT_LT(direct_report.solver_error, 1e-12);
+  EXPECT_LE(iterative_report.solver_error, 1e-9);
+  EXPECT_GT(iterative_report.solver_iterations, 0);
+  // Measured differences: 3e-9 (bunny) to 3e-7 (fandisk) mean edge lengths.
+  EXPECT_LT(max_difference(direct, iterative), 2e-6);
+  // The energy gap equals |d_it - d_direct|^2 in H's norm: relative 1e-12 or less measured.
+  const double e_direct = total_flow_energy(direct, p.topology, p.frame, weights);
+  const double e_iterative = total_flow_energy(iterative, p.topology, p.frame, weights);
+  EXPECT_LT(e_direct, total_flow_energy(p.frame.P, p.topology, p.frame, weights));
+  EXPECT_NEAR(e_iterative, e_direct, 1e-10 * e_direct);
+}
+
+INSTANTIATE_TEST_SUITE_P(Data, FlowSolverAgree,
+                         ::testing::Values(AgreeCase{"bunny_uniform.off", 1.0}, AgreeCase{"fandisk.off", 1.0},
+                                           AgreeCase{"max-planck-5k.obj", 1.0}, AgreeCase{"camelhead.off", 1.0},
+                                           AgreeCase{"spot.obj", 0.2}),
+                         [](const auto& param_info) {
+                           return test::test_name(std::string(param_info.param.file) + "_lambda_" +
+                                                  std::to_string(static_cast<int>(10 * param_info.param.lambda)));
+                         });
+
+TEST(FlowSolver, AutomaticChoice) {
+  // Tiny meshes are factored; larger ones iterate.
+  FlowReport small, large;
+  solve(make_problem(read_mesh(test::data_path("sphere_low.off"))), LinearSolver::Automatic, {}, &small);
+  EXPECT_EQ(small.solver_used, LinearSolver::Direct);
+  EXPECT_EQ(small.solver_iterations, 0);
+  const Problem bunny = make_problem(read_mesh(test::data_path("bunny_uniform.off")));
+  solve(bunny, LinearSolver::Automatic, {}, &large);
+  EXPECT_EQ(large.solver_used, LinearSolver::Iterative);
+  EXPECT_GT(large.solver_iterations, 0);
+  // A weak distance term and a tinier pull leave fandisk's flat faces to the bi-Laplacian of
+  // F_smo: the iteration exhausts its budget, 18 sqrt(free vertices), and the factorisation
+  // takes over and gives the exact minimiser.
+  const Problem fandisk = make_problem(read_mesh(test::data_path("fandisk.off")));
+  EnergyWeights weak;
+  weak.lambda = 0.01;
+  weak.epsilon = 1e-9;
+  FlowReport fallback;
+  const Vertices Y = solve(fandisk, LinearSolver::Automatic, weak, &fallback);
+  EXPECT_EQ(fallback.solver_used, LinearSolver::Direct);
+  EXPECT_EQ(fallback.solver_iterations, static_cast<int>(std::ceil(18.0 * std::sqrt(6475.0))));
+  EXPECT_LT(fallback.solver_error, 1e-12);
+  EXPECT_LT(max_difference(Y, solve(fandisk, LinearSolver::Direct, weak)), 1e-12);
+}
+
+TEST(FlowSolver, SameBytesForAnyThreadCount) {
+  const Problem p = make_problem(read_mesh(test::data_path("max-planck-5k.obj")));
+  for (const LinearSolver kind : {LinearSolver::Iterative, LinearSolver::Direct}) {
+    Vertices one, two;
+    {
+      tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+      one = solve(p, kind);
+    }
+    {
+      tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+      two = solve(p, kind);
+    }
+    EXPECT_EQ(one, two);
+    EXPECT_EQ(solve(p, kind), two);
+  }
+}
+
+TEST(FlowSolver, VertexFlowSameBytesForAnyThreadCount) {
+  // bunny_uniform takes the iterative path under LinearSolver::Automatic.
+  const Mesh mesh = read_mesh(test::data_path("bunny_uniform.off"));
+  Vertices one, two;
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+    one = vertex_flow(mesh.V, mesh.F).V;
+  }
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
+    two = vertex_flow(mesh.V, mesh.F).V;
+  }
+  EXPECT_EQ(one, two);
+}
+
+TEST(FlowSolver, ReusesItsAnalysisAcrossSolves) {
+  // A second solve on moved positions (options.iterations > 1) reuses the ordering and the
+  // symbolic factorisation; it must equal a fresh solver's result.
+  Problem p = make_problem(read_mesh(test::data_path("spot.obj")));
+  FlowSystemSolver solver(p.topology, p.fixed, LinearSolver::Direct);
+  FlowReport report;
+  const Vertices first = solver.solve(p.frame, {}, report);
+  p.frame.P = first;
+  p.frame.curvature = principal_curvatures(first, p.mesh.F, p.topology);
+  const Vertices second = solver.solve(p.frame, {}, report);
+  EXPECT_LT(max_difference(second, solve(p, LinearSolver::Direct)), 1e-12);
+}
+
+TEST(FlowSolver, RejectsBadTolerance) {
+  const Problem p = make_problem(test::torus(2.0, 0.7, 20, 8));
+  EXPECT_THROW(FlowSystemSolver(p.topology, p.fixed, LinearSolver::Iterative, 0.0), std::invalid_argument);
+  EXPECT_THROW(FlowSystemSolver(p.topology, p.fixed, LinearSolver::Iterative, 1.0), std::invalid_argument);
+}
+
+TEST(FlowSolver, FlowOptionsSelectTheSolver) {
+  const Mesh mesh = read_mesh(test::data_path("bunny_uniform.off"));
+  FlowOptions options;
+  options.solver = LinearSolver::Direct;
+  const FlowResult direct = vertex_flow(mesh.V, mesh.F, options);
+  options.solver = LinearSolver::Iterative;
+  const FlowResult iterative = vertex_flow(mesh.V, mesh.F, options);
+  EXPECT_EQ(direct.report.solver_used, LinearSolver::Direct);
+  EXPECT_EQ(iterative.report.solver_used, LinearSolver::Iterative);
+  EXPECT_LT(max_difference(direct.V, iterative.V), 1e-5 * direct.report.mean_edge_length);
+}
+
+}  // namespace
+}  // namespace vertexflow
