@@ -13,6 +13,9 @@
 
 namespace vertexflow {
 
+/// Radius ratio 2r/R of the triangle (p0, p1, p2).
+double triangle_quality(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, const Eigen::Vector3d& p2);
+
 /// Radius ratio 2r/R of each face (#F).
 Eigen::VectorXd triangle_quality(const Vertices& V, const Faces& F);
 

@@ -9,6 +9,9 @@
 #include "vertexflow/statistics.h"
 #include "vertexflow/topology.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -52,19 +55,22 @@ GuardCriteria guard_criteria(const Vertices& before, const Faces& F, double min_
 
 constexpr char kFlippedOrDegenerate = 1, kLowQuality = 2;
 
-std::vector<char> bad_faces(const GuardCriteria& criteria, const Vertices& after) {
+char face_badness(const GuardCriteria& criteria, const Vertices& after, Index f) {
   const Faces& F = criteria.F;
-  std::vector<char> bad(static_cast<std::size_t>(F.rows()), 0);
-  const Eigen::VectorXd quality = triangle_quality(after, F);
-  for (Index f = 0; f < F.rows(); ++f) {
-    const Eigen::Vector3d n0 = face_normal(criteria.before, F, f), n1 = face_normal(after, F, f);
-    if (0.5 * n0.norm() < criteria.min_area) continue;
-    if (n0.dot(n1) <= 0 || 0.5 * n1.norm() < criteria.min_area) {
-      bad[static_cast<std::size_t>(f)] = kFlippedOrDegenerate;
-    } else if (quality[f] < criteria.quality_floor[f]) {
-      bad[static_cast<std::size_t>(f)] = kLowQuality;
-    }
-  }
+  const Eigen::Vector3d n0 = face_normal(criteria.before, F, f), n1 = face_normal(after, F, f);
+  if (0.5 * n0.norm() < criteria.min_area) return 0;
+  if (n0.dot(n1) <= 0 || 0.5 * n1.norm() < criteria.min_area) return kFlippedOrDegenerate;
+  const Eigen::Vector3d a = after.row(F(f, 0)), b = after.row(F(f, 1)), c = after.row(F(f, 2));
+  return triangle_quality(a, b, c) < criteria.quality_floor[f] ? kLowQuality : 0;
+}
+
+std::vector<char> bad_faces(const GuardCriteria& criteria, const Vertices& after) {
+  std::vector<char> bad(static_cast<std::size_t>(criteria.F.rows()), 0);
+  tbb::parallel_for(tbb::blocked_range<Index>(0, static_cast<Index>(criteria.F.rows()), 4096),
+                    [&](const tbb::blocked_range<Index>& r) {
+                      for (Index f = r.begin(); f != r.end(); ++f)
+                        bad[static_cast<std::size_t>(f)] = face_badness(criteria, after, f);
+                    });
   return bad;
 }
 
@@ -152,7 +158,11 @@ FlowResult vertex_flow(const Vertices& V, const Faces& F, const FlowOptions& opt
     X = solve_once(X, F, topology, solver, options, report);
     if (options.project_to_input) {
       const auto start = Clock::now();
-      X = project_near_vertices(X, input, F, topology, features, fixed);
+      std::vector<Index> free_rows;
+      for (Index i = 0; i < n; ++i) {
+        if (!fixed[static_cast<std::size_t>(i)]) free_rows.push_back(i);
+      }
+      project_near_vertices(X, free_rows, input, F, topology, features);
       report.seconds_projection += seconds_since(start);
     }
   }
@@ -166,26 +176,50 @@ FlowResult vertex_flow(const Vertices& V, const Faces& F, const FlowOptions& opt
   report.flipped_before_guard = static_cast<Index>(std::count(bad.begin(), bad.end(), kFlippedOrDegenerate));
   report.low_quality_before_guard = static_cast<Index>(std::count(bad.begin(), bad.end(), kLowQuality));
   // Each round halves every free vertex of a bad face once; after max_halvings rounds their
-  // displacement is zero, and a face whose vertices are all back at the input is not bad.
-  std::vector<char> shortened(static_cast<std::size_t>(n), 0);
-  for (int round = 1; std::count(bad.begin(), bad.end(), 0) < static_cast<std::ptrdiff_t>(bad.size()); ++round) {
-    std::vector<char> in_bad_face(static_cast<std::size_t>(n), 0);
-    for (Index f = 0; f < F.rows(); ++f) {
-      if (!bad[static_cast<std::size_t>(f)]) continue;
-      for (int k = 0; k < 3; ++k) in_bad_face[static_cast<std::size_t>(F(f, k))] = 1;
+  // displacement is zero, and a face whose vertices are all back at the input is not bad. Only
+  // the faces around the vertices a round moved are judged again.
+  std::vector<char> shortened(static_cast<std::size_t>(n), 0), touched(static_cast<std::size_t>(n), 0);
+  std::vector<Index> bad_list;
+  for (Index f = 0; f < F.rows(); ++f) {
+    if (bad[static_cast<std::size_t>(f)]) bad_list.push_back(f);
+  }
+  for (int round = 1; !bad_list.empty(); ++round) {
+    std::vector<Index> moved, reproject;
+    for (const Index f : bad_list) {
+      for (int k = 0; k < 3; ++k) {
+        const Index i = F(f, k);
+        const auto v = static_cast<std::size_t>(i);
+        if (touched[v] || fixed[v]) continue;
+        touched[v] = 1;
+        moved.push_back(i);
+      }
     }
-    std::vector<char> unchanged(static_cast<std::size_t>(n), 1);
-    for (Index i = 0; i < n; ++i) {
+    std::sort(moved.begin(), moved.end());
+    for (const Index i : moved) {
       const auto v = static_cast<std::size_t>(i);
-      if (!in_bad_face[v] || fixed[v]) continue;
+      touched[v] = 0;
       step[v] = round >= options.max_halvings ? 0.0 : 0.5 * step[v];
       shortened[v] = 1;
       X.row(i) = input.row(i) + step[v] * displacement.row(i);
       // Back onto the surface, except at step 0: the input position itself, exactly.
-      unchanged[v] = step[v] == 0.0 || !options.project_to_input;
+      if (step[v] != 0.0 && options.project_to_input) reproject.push_back(i);
     }
-    X = project_near_vertices(X, input, F, topology, features, unchanged);
-    bad = bad_faces(criteria, X);
+    project_near_vertices(X, reproject, input, F, topology, features);
+    std::vector<Index> faces;
+    for (const Index i : moved) {
+      for (Index k = topology.face_offsets[static_cast<std::size_t>(i)];
+           k < topology.face_offsets[static_cast<std::size_t>(i) + 1]; ++k)
+        faces.push_back(topology.vertex_faces[static_cast<std::size_t>(k)]);
+    }
+    std::sort(faces.begin(), faces.end());
+    faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+    for (const Index f : faces) bad[static_cast<std::size_t>(f)] = face_badness(criteria, X, f);
+    bad_list.clear();
+    for (const Index f : faces) {
+      if (bad[static_cast<std::size_t>(f)]) bad_list.push_back(f);
+    }
+    // Bad faces away from the moved vertices cannot exist: they were bad before and so had all
+    // their free vertices moved (or all fixed, and then they are at the input and not bad).
   }
   report.limited_vertices = static_cast<Index>(std::count(shortened.begin(), shortened.end(), 1));
   report.d *= scale;

@@ -160,6 +160,7 @@ SurfaceFeatures detect_features(const Vertices& V, const Faces& F, const Topolog
             static_cast<Index>(e));
     }
   }
+  features.vertex_normals = vertex_normals(V, F);
   features.vertex_kind.resize(static_cast<std::size_t>(topology.num_vertices));
   for (std::size_t v = 0; v < features.vertex_kind.size(); ++v) {
     std::sort(features.vertex_sharp[v].begin(), features.vertex_sharp[v].end());  // deterministic walks
@@ -207,10 +208,9 @@ SurfaceFeatures detect_features(const Vertices& V, const Faces& F, const Topolog
   return features;
 }
 
-Vertices project_near_vertices(const Vertices& points, const Vertices& V, const Faces& F, const Topology& topology,
-                               const SurfaceFeatures& features, const std::vector<char>& skip) {
-  Vertices out = points;
-  const Vertices normals = vertex_normals(V, F);
+void project_near_vertices(Vertices& points, const std::vector<Index>& rows, const Vertices& V, const Faces& F,
+                           const Topology& topology, const SurfaceFeatures& features) {
+  const Vertices& normals = features.vertex_normals;
   auto for_faces_of = [&](Index v, auto&& body) {
     const auto begin = topology.face_offsets[static_cast<std::size_t>(v)];
     const auto end = topology.face_offsets[static_cast<std::size_t>(v) + 1];
@@ -249,15 +249,13 @@ Vertices project_near_vertices(const Vertices& points, const Vertices& V, const 
                   [&](Index f) { return closest_on_face(x, V, F, f); });
       if (best.element >= 0) best.point = phong_point(best.point, V, F, best.element, normals, features);
     }
-    if (best.element >= 0) out.row(i) = best.point.transpose();
+    if (best.element >= 0) points.row(i) = best.point.transpose();
   };
-  tbb::parallel_for(tbb::blocked_range<Index>(0, static_cast<Index>(points.rows()), 512),
-                    [&](const tbb::blocked_range<Index>& range) {
-                      for (Index i = range.begin(); i != range.end(); ++i) {
-                        if (!skip[static_cast<std::size_t>(i)]) project(i);
-                      }
+  // Each row reads only its own query point and writes only itself: any order, same result.
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rows.size(), 256),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t k = range.begin(); k != range.end(); ++k) project(rows[k]);
                     });
-  return out;
 }
 
 }  // namespace vertexflow

@@ -16,20 +16,24 @@ struct SurfaceFeatures {
   std::vector<char> sharp_edge;                  ///< per edge of the topology
   std::vector<std::vector<Index>> vertex_sharp;  ///< sharp edges at each vertex
   std::vector<Index> face_patch;                 ///< per face
-  std::vector<Kind> vertex_kind;                 ///< Crease: exactly two sharp edges; Corner: 1 or >= 3
+  /// Crease: exactly two sharp edges that continue each other within the feature angle;
+  /// Corner: one, three or more, or two that turn.
+  std::vector<Kind> vertex_kind;
+  Vertices vertex_normals;  ///< of the mesh (curvature.h), for the Phong height of projections
 };
 
 /// Features for `angle_degrees` (>= 180 marks nothing sharp).
 SurfaceFeatures detect_features(const Vertices& V, const Faces& F, const Topology& topology, double angle_degrees);
 
-/// For each row i of `points` not marked in `skip`, a point of the surface (V, F) near it,
-/// found by a walk that starts at vertex i of (V, F): a smooth vertex walks over the faces of its
-/// own patch, from face to a closer face sharing a vertex, until none is closer; a crease
-/// vertex walks likewise along its crease's sharp edges; a corner is not moved. A walk, not a
-/// global nearest-point query, so that a point never jumps through a thin wall, and bounded by
-/// the features, so that no vertex leaves its crease or crosses one (which would cut the edge
-/// off a CAD part). Parallel over rows, deterministic.
-Vertices project_near_vertices(const Vertices& points, const Vertices& V, const Faces& F, const Topology& topology,
-                               const SurfaceFeatures& features, const std::vector<char>& skip);
+/// Moves each row i listed in `rows` of `points` (a query point near vertex i of (V, F)) to a
+/// point of the surface (V, F) near it, found by a walk that starts at vertex i: a smooth
+/// vertex walks over the faces of its own patch, from face to a closer face sharing a vertex,
+/// until none is closer, and is then lifted to the Phong surface; a crease vertex walks likewise
+/// along its crease's sharp edges; a corner is not moved. A walk, not a global nearest-point
+/// query, so that a point never jumps through a thin wall, and bounded by the features, so that
+/// no vertex leaves its crease or crosses one (which would cut the edge off a CAD part).
+/// Parallel over rows, deterministic.
+void project_near_vertices(Vertices& points, const std::vector<Index>& rows, const Vertices& V, const Faces& F,
+                           const Topology& topology, const SurfaceFeatures& features);
 
 }  // namespace vertexflow

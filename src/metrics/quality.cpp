@@ -8,15 +8,17 @@
 
 namespace vertexflow {
 
+double triangle_quality(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, const Eigen::Vector3d& p2) {
+  const double a = (p1 - p2).norm(), b = (p2 - p0).norm(), c = (p0 - p1).norm();
+  const double denominator = a * b * c;
+  const double value = denominator > 0 ? (b + c - a) * (c + a - b) * (a + b - c) / denominator : 0.0;
+  return std::clamp(value, 0.0, 1.0);
+}
+
 Eigen::VectorXd triangle_quality(const Vertices& V, const Faces& F) {
   Eigen::VectorXd q(F.rows());
-  for (Eigen::Index f = 0; f < F.rows(); ++f) {
-    const Eigen::Vector3d p0 = V.row(F(f, 0)), p1 = V.row(F(f, 1)), p2 = V.row(F(f, 2));
-    const double a = (p1 - p2).norm(), b = (p2 - p0).norm(), c = (p0 - p1).norm();
-    const double denominator = a * b * c;
-    const double value = denominator > 0 ? (b + c - a) * (c + a - b) * (a + b - c) / denominator : 0.0;
-    q[f] = std::clamp(value, 0.0, 1.0);
-  }
+  for (Eigen::Index f = 0; f < F.rows(); ++f)
+    q[f] = triangle_quality(V.row(F(f, 0)).transpose(), V.row(F(f, 1)).transpose(), V.row(F(f, 2)).transpose());
   return q;
 }
 
