@@ -205,11 +205,20 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
           {"project_to_input", o->flow.project_to_input},
           {"feature_angle", o->flow.feature_angle},
           {"fairness_target", o->flow.fairness_target == FairnessTarget::Zero ? "zero" : "input-normal"}};
-      report["seconds"] = {
-          {"read", seconds_read},     {"curvature", r.seconds_curvature},   {"assembly", r.seconds_assembly},
-          {"solve", r.seconds_solve}, {"projection", r.seconds_projection}, {"guard", r.seconds_guard},
-          {"write", seconds_write}};
-      report["solver"] = {{"relative_residual", r.solver_error}, {"d", r.d}, {"mean_edge_length", r.mean_edge_length}};
+      report["seconds"] = {{"read", seconds_read},
+                           {"curvature", r.seconds_curvature},
+                           {"assembly", r.seconds_assembly},
+                           {"solve", r.seconds_solve},
+                           {"factorization", r.seconds_factorization},
+                           {"projection", r.seconds_projection},
+                           {"guard", r.seconds_guard},
+                           {"write", seconds_write}};
+      report["solver"] = {
+          {"relative_residual", r.solver_error},
+          {"d", r.d},
+          {"mean_edge_length", r.mean_edge_length},
+          {"method", r.solver_used == LinearSolver::Direct ? "direct (CHOLMOD)" : "conjugate gradients"},
+          {"iterations", r.solver_iterations}};
       report["guard"] = {{"faces_bad_before_guard", r.flipped_before_guard},
                          {"faces_low_quality_before_guard", r.low_quality_before_guard},
                          {"limited_vertices", r.limited_vertices},

@@ -106,7 +106,7 @@ struct FlowReport {
   Index flipped_before_guard = 0;      ///< faces the unguarded solution turned or degenerated
   Index low_quality_before_guard = 0;  ///< faces it left below their quality floor
   Index limited_vertices = 0;          ///< vertices whose displacement the guard shortened
-  Index fixed_vertices = 0;            ///< boundary, pinned and isolated vertices
+  Index fixed_vertices = 0;            ///< boundary, pinned, isolated and corner vertices
   double seconds_curvature = 0, seconds_assembly = 0, seconds_solve = 0, seconds_projection = 0, seconds_guard = 0;
   /// Direct: CHOLMOD's analysis and numeric factorisation; iterative: the preconditioner.
   double seconds_factorization = 0;
