@@ -64,4 +64,14 @@ nlohmann::json to_json(const ReadReport& report) {
           {"zero_area_faces_removed", report.zero_area_faces_removed}};
 }
 
+nlohmann::json to_json(const DistanceStats& stats, double length_scale) {
+  return {{"mean", stats.mean},
+          {"rms", stats.rms},
+          {"max", stats.max},
+          {"mean_relative", stats.mean / length_scale},
+          {"rms_relative", stats.rms / length_scale},
+          {"max_relative", stats.max / length_scale},
+          {"points", stats.points}};
+}
+
 }  // namespace vertexflow::cli

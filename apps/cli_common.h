@@ -1,6 +1,7 @@
 // Pieces every `vertexflow` subcommand shares: reading with warnings, JSON conversion.
 #pragma once
 
+#include "vertexflow/distance.h"
 #include "vertexflow/io.h"
 #include "vertexflow/mesh_info.h"
 
@@ -27,6 +28,8 @@ std::string describe_format(const ReadReport& report);
 nlohmann::json to_json(const MeshInfo& info);
 nlohmann::json to_json(const QualityStats& stats);
 nlohmann::json to_json(const ReadReport& report);
+/// mean, rms, max (absolute), the same divided by `length_scale` (*_relative), and points.
+nlohmann::json to_json(const DistanceStats& stats, double length_scale);
 
 /// Registers the subcommands (one function per command file).
 void register_info_command(CLI::App& app, const GlobalOptions& global);
@@ -36,5 +39,6 @@ void register_simplify_command(CLI::App& app, const GlobalOptions& global);
 void register_remesh_command(CLI::App& app, const GlobalOptions& global);
 void register_render_command(CLI::App& app, const GlobalOptions& global);
 void register_report_command(CLI::App& app, const GlobalOptions& global);
+void register_compare_command(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace vertexflow::cli

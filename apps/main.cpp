@@ -22,6 +22,7 @@ int main(int argc, char** argv) {
   register_remesh_command(app, global);
   register_render_command(app, global);
   register_report_command(app, global);
+  register_compare_command(app, global);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

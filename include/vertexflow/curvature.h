@@ -26,6 +26,8 @@
 #include "vertexflow/mesh.h"
 #include "vertexflow/topology.h"
 
+#include <cmath>
+
 namespace vertexflow {
 
 /// How face normals are weighted into vertex normals.
@@ -73,6 +75,13 @@ struct Curvature {
   [[nodiscard]] Eigen::VectorXd gaussian() const { return k1.cwiseProduct(k2); }
   /// |k1| + |k2|: the curvature magnitude the flow's energies use.
   [[nodiscard]] Eigen::VectorXd absolute_sum() const { return k1.cwiseAbs() + k2.cwiseAbs(); }
+  /// K_i = |k1| T1 T1^T + |k2| T2 T2^T of vertex i (3 x 3, symmetric positive semi-definite):
+  /// the edge metric of the paper's Eq. 2 as a quadratic form, f_i(e) = e^T K_i e. Its trace
+  /// is absolute_sum()[i].
+  [[nodiscard]] Eigen::Matrix3d absolute_tensor(Index i) const {
+    const Eigen::Vector3d t1 = T1.row(i).transpose(), t2 = T2.row(i).transpose();
+    return std::abs(k1[i]) * t1 * t1.transpose() + std::abs(k2[i]) * t2 * t2.transpose();
+  }
 };
 
 /// Estimates principal curvatures and directions (Rusinkiewicz 2004). Parallel over faces and

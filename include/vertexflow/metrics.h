@@ -5,6 +5,8 @@
 #include "vertexflow/mesh.h"
 #include "vertexflow/topology.h"
 
+#include <vector>
+
 namespace vertexflow {
 
 /// Spearman rank correlation of two equally long samples (ties get their average rank);
@@ -27,5 +29,12 @@ struct EdgeErrorStats {
   double coefficient_of_variation = 0;  ///< std / mean
 };
 EdgeErrorStats edge_error_stats(const Vertices& V, const Topology& topology, const Curvature& surface);
+
+/// The same with the surface's curvature given per vertex of V as the tensor K_i of
+/// Curvature::absolute_tensor (e.g. a reference surface's tensors interpolated at the vertices,
+/// compare.h): delta_e = (e^T K_i e + e^T K_j e) / 16. `surface_tensors` has one entry per
+/// vertex; throws std::invalid_argument otherwise.
+EdgeErrorStats edge_error_stats(const Vertices& V, const Topology& topology,
+                                const std::vector<Eigen::Matrix3d>& surface_tensors);
 
 }  // namespace vertexflow

@@ -13,12 +13,6 @@ Eigen::Vector3d row3(const Vertices& M, Index i) {
   return M.row(i).transpose();
 }
 
-// K_i = |k_i1| T_i1 T_i1^T + |k_i2| T_i2 T_i2^T (Eq. 2 written as a quadratic form).
-Eigen::Matrix3d curvature_tensor(const Curvature& c, Index i) {
-  const Eigen::Vector3d t1 = row3(c.T1, i), t2 = row3(c.T2, i);
-  return std::abs(c.k1[i]) * t1 * t1.transpose() + std::abs(c.k2[i]) * t2 * t2.transpose();
-}
-
 // Eq. 10.
 double fairness_weight(const Curvature& c, Index i) {
   return std::exp(-(std::abs(c.k1[i]) + std::abs(c.k2[i])));
@@ -69,11 +63,11 @@ double edge_metric_energy(const Vertices& V, const Topology& topology, const Flo
 Vertices edge_metric_gradient(const Vertices& V, const Topology& topology, const FlowFrame& frame) {
   Vertices g = Vertices::Zero(V.rows(), 3);
   for (Index i = 0; i < static_cast<Index>(V.rows()); ++i) {
-    const Eigen::Matrix3d Ki = curvature_tensor(frame.curvature, i);
+    const Eigen::Matrix3d Ki = frame.curvature.absolute_tensor(i);
     const auto [begin, end] = topology.ring(i);
     Eigen::Vector3d gi = Eigen::Vector3d::Zero();
     for (const Index* j = begin; j != end; ++j)
-      gi += (Ki + curvature_tensor(frame.curvature, *j)) * (row3(V, i) - row3(V, *j));
+      gi += (Ki + frame.curvature.absolute_tensor(*j)) * (row3(V, i) - row3(V, *j));
     g.row(i) = gi.transpose();
   }
   return g;
@@ -132,7 +126,7 @@ LeastSquaresSystem assemble_flow_system(const Topology& topology, const FlowFram
   };
 
   std::vector<Eigen::Matrix3d> K(static_cast<std::size_t>(n));
-  for (Index i = 0; i < n; ++i) K[static_cast<std::size_t>(i)] = curvature_tensor(c, i);
+  for (Index i = 0; i < n; ++i) K[static_cast<std::size_t>(i)] = c.absolute_tensor(i);
 
   for (Index i = 0; i < n; ++i) {
     const auto [begin, end] = topology.ring(i);

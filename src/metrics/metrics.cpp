@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace vertexflow {
@@ -49,18 +51,27 @@ double redistribution_rho(const Eigen::VectorXd& surface_curvature, const Vertic
 }
 
 EdgeErrorStats edge_error_stats(const Vertices& V, const Topology& topology, const Curvature& surface) {
+  std::vector<Eigen::Matrix3d> tensors(static_cast<std::size_t>(surface.k1.size()));
+  for (Index i = 0; i < surface.k1.size(); ++i) tensors[static_cast<std::size_t>(i)] = surface.absolute_tensor(i);
+  return edge_error_stats(V, topology, tensors);
+}
+
+EdgeErrorStats edge_error_stats(const Vertices& V, const Topology& topology,
+                                const std::vector<Eigen::Matrix3d>& surface_tensors) {
+  if (surface_tensors.size() != static_cast<std::size_t>(V.rows()))
+    throw std::invalid_argument("edge_error_stats: " + std::to_string(surface_tensors.size()) + " tensors for " +
+                                std::to_string(V.rows()) + " vertices");
   EdgeErrorStats stats;
   const Index ne = topology.num_edges();
   if (ne == 0) return stats;
   Eigen::VectorXd delta(ne);
-  auto metric = [&](Index v, const Eigen::Vector3d& e) {  // Eq. 2
-    return std::abs(surface.k1[v]) * std::pow(e.dot(surface.T1.row(v).transpose()), 2) +
-           std::abs(surface.k2[v]) * std::pow(e.dot(surface.T2.row(v).transpose()), 2);
-  };
   for (Index e = 0; e < ne; ++e) {
     const Index i = topology.edges(e, 0), j = topology.edges(e, 1);
     const Eigen::Vector3d d = (V.row(j) - V.row(i)).transpose();
-    delta[e] = 0.5 * (metric(i, d) + metric(j, d)) / 8.0;  // Eq. 4, divided by 8 (metrics.md)
+    // Eq. 2-4 (f_em = the mean of both endpoints' quadratic forms), divided by 8 (metrics.md).
+    const double f_em = 0.5 * (d.dot(surface_tensors[static_cast<std::size_t>(i)] * d) +
+                               d.dot(surface_tensors[static_cast<std::size_t>(j)] * d));
+    delta[e] = f_em / 8.0;
   }
   stats.mean = delta.mean();
   if (stats.mean > 0) {

@@ -1,0 +1,141 @@
+// Distances between triangle meshes (../docs/metrics.md, "Shape fidelity").
+//
+// Distance A -> B: points on A (area-uniform samples, plus every vertex and every edge
+// midpoint of A), each measured to the exact closest point on B's triangles. The closest
+// points come from CGAL's AABB tree (a bounding-volume hierarchy over B) with CGAL's exact
+// point-triangle projection, in double precision.
+//
+// Conventions
+// - Lengths are in the units of the meshes' coordinates; callers that want them relative to a
+//   bounding-box diagonal or a mean edge length divide by it (compare.h does).
+// - Mean and RMS are taken over the area-uniform samples only, so they estimate the surface
+//   integrals (1/|A|) int_A d and sqrt((1/|A|) int_A d^2) independently of how A is
+//   tessellated. The maximum is taken over all points: vertices and edge midpoints are where
+//   a coarse mesh strays furthest from a fine one, and random samples would miss them. When A
+//   has no area (every face degenerate) mean and RMS fall back to all points.
+// - Determinism: for a given seed the samples are the same on every run and for any number of
+//   threads (they are drawn in one sequential stream), and the parallel queries run in fixed
+//   blocks with sums taken in a fixed order, so every figure is bit-identical for 1 or more
+//   threads.
+// - Any triangle list is accepted (non-manifold, open, with degenerate faces): a degenerate
+//   triangle of B is treated as its longest edge.
+#pragma once
+
+#include "vertexflow/mesh.h"
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace vertexflow {
+
+struct SamplingOptions {
+  /// Area-uniform random samples (i.i.d., each face chosen with probability proportional to
+  /// its area, then a uniform point in it). metrics.md asks for at least 200,000.
+  Index samples = 200000;
+  /// Seed of the random stream (std::mt19937_64); equal seeds give equal samples.
+  std::uint64_t seed = 1;
+  /// Also take every vertex of A (rows of V, referenced or not).
+  bool vertices = true;
+  /// Also take the midpoint of every edge of A (each undirected edge once).
+  bool edge_midpoints = true;
+};
+
+/// Points on a mesh, in three consecutive blocks: the area-uniform samples, then the vertices,
+/// then the edge midpoints.
+struct SurfaceSamples {
+  Vertices points;
+  Index num_area_samples = 0;
+  Index num_vertices = 0;
+  Index num_edge_midpoints = 0;
+};
+
+/// Samples the surface (V, F) as described by `options`. Area samples are sorted by face
+/// (face order, the order they were drawn within a face) so that neighbouring queries are
+/// close in space. Throws std::invalid_argument if `options.samples` is negative or F indexes
+/// outside V.
+SurfaceSamples sample_surface(const Vertices& V, const Faces& F, const SamplingOptions& options = {});
+
+/// The closest point of a mesh B to a query point.
+struct ClosestPoint {
+  Eigen::Vector3d point = Eigen::Vector3d::Zero();  ///< on B
+  double squared_distance = 0;                      ///< |query - point|^2
+  Index face = -1;                                  ///< the face of B containing `point`
+  /// Barycentric coordinates of `point` in `face` (weights of its corners F(face, 0..2)):
+  /// non-negative, summing to 1. Use them to interpolate B's per-vertex data at `point`.
+  Eigen::Vector3d barycentric = Eigen::Vector3d::Zero();
+};
+
+/// Closest-point queries against a fixed mesh B: an AABB tree built once (with CGAL's internal
+/// k-d tree for the first guess), then queried any number of times, from any number of threads.
+/// Holds its own copy of B's triangles.
+class DistanceQuery {
+ public:
+  /// Builds the tree over the triangles of (V, F). Throws std::invalid_argument if F is empty
+  /// or indexes outside V.
+  DistanceQuery(const Vertices& V, const Faces& F);
+  ~DistanceQuery();
+  DistanceQuery(DistanceQuery&&) noexcept;
+  DistanceQuery& operator=(DistanceQuery&&) noexcept;
+  DistanceQuery(const DistanceQuery&) = delete;
+  DistanceQuery& operator=(const DistanceQuery&) = delete;
+
+  /// The closest point of B to p. Where several points of B are equally close (p on the
+  /// medial axis, or the closest point on an edge shared by two faces) any one of them.
+  [[nodiscard]] ClosestPoint closest_point(const Eigen::Vector3d& p) const;
+
+  /// closest_point for every row of P, in parallel (TBB); the same result for any number of
+  /// threads.
+  [[nodiscard]] std::vector<ClosestPoint> closest_points(const Vertices& P) const;
+
+  /// Squared distance from every row of P to B (#P), in parallel, thread-count independent.
+  [[nodiscard]] Eigen::VectorXd squared_distances(const Vertices& P) const;
+
+  /// B's vertices and faces (the copy the tree was built from).
+  [[nodiscard]] const Vertices& vertices() const;
+  [[nodiscard]] const Faces& faces() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// One-sided distance A -> B (lengths in the meshes' units).
+struct DistanceStats {
+  double mean = 0;   ///< mean over the area-uniform samples
+  double rms = 0;    ///< root mean square over the area-uniform samples
+  double max = 0;    ///< maximum over all points (samples, vertices, edge midpoints)
+  Index points = 0;  ///< points measured in total
+
+  /// The same figures divided by `length` (e.g. a bounding-box diagonal); `points` unchanged.
+  [[nodiscard]] DistanceStats relative_to(double length) const {
+    return {mean / length, rms / length, max / length, points};
+  }
+};
+
+/// Distance from the points `a` (sampled on A by sample_surface) to the mesh B behind `b`.
+DistanceStats one_sided_distance(const SurfaceSamples& a, const DistanceQuery& b);
+
+/// Distance from mesh A to mesh B: samples A with `options` and queries a tree built over B.
+DistanceStats one_sided_distance(const Vertices& VA, const Faces& FA, const Vertices& VB, const Faces& FB,
+                                 const SamplingOptions& options = {});
+
+/// Both one-sided distances and the Hausdorff distance max(max A->B, max B->A).
+struct SymmetricDistance {
+  DistanceStats a_to_b;
+  DistanceStats b_to_a;
+  double hausdorff = 0;
+
+  [[nodiscard]] SymmetricDistance relative_to(double length) const {
+    return {a_to_b.relative_to(length), b_to_a.relative_to(length), hausdorff / length};
+  }
+};
+
+/// A -> B and B -> A with the same sampling options for both.
+SymmetricDistance symmetric_distance(const Vertices& VA, const Faces& FA, const Vertices& VB, const Faces& FB,
+                                     const SamplingOptions& options = {});
+
+/// Combines the two one-sided figures (hausdorff = the larger maximum).
+SymmetricDistance symmetric_distance(const DistanceStats& a_to_b, const DistanceStats& b_to_a);
+
+}  // namespace vertexflow

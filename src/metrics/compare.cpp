@@ -1,0 +1,159 @@
+// The figures of docs/metrics.md for a result, its input and an optional reference
+// (include/vertexflow/compare.h).
+#include "vertexflow/compare.h"
+
+#include "vertexflow/flow.h"
+#include "vertexflow/statistics.h"
+#include "vertexflow/topology.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+
+#include <cmath>
+#include <string>
+
+namespace vertexflow {
+namespace {
+
+// The topology of a mesh compare_meshes measures; CompareError naming the mesh if it has no
+// faces, bad indices or is not manifold (the curvature estimator needs a manifold).
+Topology checked_topology(const Mesh& mesh, MeshRole role) {
+  const std::string name = std::string("the ") + to_string(role) + " mesh";
+  if (mesh.num_faces() == 0) throw CompareError(role, name + " has no faces");
+  Topology topology;
+  try {
+    topology = build_topology(mesh.F, mesh.num_vertices());
+  } catch (const std::invalid_argument& e) {
+    throw CompareError(role, name + ": " + e.what());
+  }
+  if (!topology.is_manifold()) throw CompareError(role, name + ": " + describe_non_manifold(topology));
+  return topology;
+}
+
+// The surface's own values at its own vertices (no interpolation needed).
+SurfaceCurvatureAtPoints own_curvature(const Curvature& c) {
+  SurfaceCurvatureAtPoints out;
+  out.tensors.resize(static_cast<std::size_t>(c.k1.size()));
+  for (Index i = 0; i < c.k1.size(); ++i) out.tensors[static_cast<std::size_t>(i)] = c.absolute_tensor(i);
+  out.magnitude = c.absolute_sum();
+  return out;
+}
+
+}  // namespace
+
+const char* to_string(MeshRole role) {
+  switch (role) {
+    case MeshRole::Result:
+      return "result";
+    case MeshRole::Input:
+      return "input";
+    case MeshRole::Reference:
+      return "reference";
+  }
+  return "?";
+}
+
+MeanCurvaturePercentiles mean_curvature_percentiles(const Curvature& curvature) {
+  const Eigen::VectorXd h = curvature.mean().cwiseAbs();
+  const std::vector<double> values(h.data(), h.data() + h.size());
+  return {percentile(values, 5), percentile(values, 50), percentile(values, 95), percentile(values, 99)};
+}
+
+SurfaceCurvatureAtPoints surface_curvature_at(const Vertices& P, const DistanceQuery& surface,
+                                              const Curvature& surface_curvature) {
+  if (surface_curvature.k1.size() != surface.vertices().rows())
+    throw std::invalid_argument("surface_curvature_at: curvature of " + std::to_string(surface_curvature.k1.size()) +
+                                " vertices for a surface of " + std::to_string(surface.vertices().rows()));
+  const Faces& F = surface.faces();
+  const std::vector<ClosestPoint> closest = surface.closest_points(P);
+  SurfaceCurvatureAtPoints out;
+  out.tensors.resize(closest.size());
+  out.magnitude.resize(P.rows());
+  const Eigen::VectorXd magnitude = surface_curvature.absolute_sum();
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, closest.size(), 4096), [&](const auto& range) {
+    for (std::size_t i = range.begin(); i != range.end(); ++i) {
+      const ClosestPoint& c = closest[i];
+      Eigen::Matrix3d K = Eigen::Matrix3d::Zero();
+      double m = 0;
+      for (int k = 0; k < 3; ++k) {
+        const Index v = F(c.face, k);
+        K += c.barycentric[k] * surface_curvature.absolute_tensor(v);
+        m += c.barycentric[k] * magnitude[v];
+      }
+      out.tensors[i] = K;
+      out.magnitude[static_cast<Eigen::Index>(i)] = m;
+    }
+  });
+  return out;
+}
+
+MeshComparison compare_meshes(const Mesh& result, const Mesh& input, const Mesh* reference,
+                              const CompareOptions& options) {
+  const Topology result_topology = checked_topology(result, MeshRole::Result);
+  const Topology input_topology = checked_topology(input, MeshRole::Input);
+  const Topology reference_topology = reference ? checked_topology(*reference, MeshRole::Reference) : Topology{};
+
+  MeshComparison c;
+  c.has_reference = reference != nullptr;
+  c.length_scale = bounding_box(reference ? reference->V : input.V).diagonal();
+
+  // Everything that does not depend on anything else, at once: tree builds and sampling are
+  // serial inside, the curvature estimator parallel. Each mesh is sampled once and each tree
+  // built once; the result's samples serve both the input and the reference.
+  std::optional<DistanceQuery> result_query, input_query, reference_query;
+  SurfaceSamples result_samples, input_samples, reference_samples;
+  Curvature result_curvature, input_curvature, reference_curvature;
+  tbb::parallel_invoke(
+      [&] { result_query.emplace(result.V, result.F); }, [&] { input_query.emplace(input.V, input.F); },
+      [&] { result_samples = sample_surface(result.V, result.F, options.sampling); },
+      [&] { input_samples = sample_surface(input.V, input.F, options.sampling); },
+      [&] { result_curvature = principal_curvatures(result.V, result.F, result_topology, options.curvature); },
+      [&] { input_curvature = principal_curvatures(input.V, input.F, input_topology, options.curvature); },
+      [&] {
+        if (!reference) return;
+        tbb::parallel_invoke([&] { reference_query.emplace(reference->V, reference->F); },
+                             [&] { reference_samples = sample_surface(reference->V, reference->F, options.sampling); },
+                             [&] {
+                               reference_curvature = principal_curvatures(reference->V, reference->F,
+                                                                          reference_topology, options.curvature);
+                             });
+      });
+
+  // Shape fidelity.
+  c.result_input = symmetric_distance(one_sided_distance(result_samples, *input_query),
+                                      one_sided_distance(input_samples, *result_query));
+  if (reference) {
+    c.result_reference = symmetric_distance(one_sided_distance(result_samples, *reference_query),
+                                            one_sided_distance(reference_samples, *result_query));
+    c.input_reference = symmetric_distance(one_sided_distance(input_samples, *reference_query),
+                                           one_sided_distance(reference_samples, *input_query));
+  }
+
+  // The surface's curvature at both meshes' vertices.
+  SurfaceCurvatureAtPoints at_input, at_result;
+  if (reference) {
+    at_input = surface_curvature_at(input.V, *reference_query, reference_curvature);
+    at_result = surface_curvature_at(result.V, *reference_query, reference_curvature);
+  } else {
+    at_input = own_curvature(input_curvature);
+    at_result = surface_curvature_at(result.V, *input_query, input_curvature);
+  }
+  c.edge_error_input = edge_error_stats(input.V, input_topology, at_input.tensors);
+  c.edge_error_result = edge_error_stats(result.V, result_topology, at_result.tensors);
+  c.redistribution_rho_input = redistribution_rho(at_input.magnitude, input.V, input.F);
+  c.redistribution_rho_result = redistribution_rho(at_result.magnitude, result.V, result.F);
+  c.abs_mean_curvature_input = mean_curvature_percentiles(input_curvature);
+  c.abs_mean_curvature_result = mean_curvature_percentiles(result_curvature);
+
+  // Mesh quality.
+  c.quality_input = summarize_quality(triangle_quality(input.V, input.F));
+  c.quality_result = summarize_quality(triangle_quality(result.V, result.F));
+  c.degenerate_faces_input = static_cast<Index>(degenerate_faces(input.V, input.F).size());
+  c.degenerate_faces_result = static_cast<Index>(degenerate_faces(result.V, result.F).size());
+  c.same_connectivity = result.V.rows() == input.V.rows() && result.F.rows() == input.F.rows() && result.F == input.F;
+  if (c.same_connectivity) c.flipped_faces = static_cast<Index>(flipped_faces(input.V, result.V, input.F).size());
+  return c;
+}
+
+}  // namespace vertexflow
