@@ -11,8 +11,8 @@
 // - Mean and RMS are taken over the area-uniform samples only, so they estimate the surface
 //   integrals (1/|A|) int_A d and sqrt((1/|A|) int_A d^2) independently of how A is
 //   tessellated. The maximum is taken over all points: vertices and edge midpoints are where
-//   a coarse mesh strays furthest from a fine one, and random samples would miss them. When A
-//   has no area (every face degenerate) mean and RMS fall back to all points.
+//   a coarse mesh strays furthest from a fine one, and random samples would miss them. Without
+//   area samples (samples = 0, or every face of A degenerate) mean and RMS are over all points.
 // - Determinism: for a given seed the samples are the same on every run and for any number of
 //   threads (they are drawn in one sequential stream), and the parallel queries run in fixed
 //   blocks with sums taken in a fixed order, so every figure is bit-identical for 1 or more
@@ -90,6 +90,12 @@ class DistanceQuery {
 
   /// Squared distance from every row of P to B (#P), in parallel, thread-count independent.
   [[nodiscard]] Eigen::VectorXd squared_distances(const Vertices& P) const;
+
+  /// The largest squared distance from the rows first_row, first_row + 1, ... of P to B, or
+  /// `at_least` when none is larger. Exact, and faster than squared_distances when `at_least`
+  /// is near the answer: a point whose distance to a point of B found cheaply (on the triangle
+  /// nearest to the previous point) is already within sqrt(at_least) is not searched for.
+  [[nodiscard]] double max_squared_distance(const Vertices& P, Index first_row = 0, double at_least = 0) const;
 
   /// B's vertices and faces (the copy the tree was built from).
   [[nodiscard]] const Vertices& vertices() const;

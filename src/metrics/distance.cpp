@@ -15,6 +15,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -40,13 +41,14 @@ inline double squared_distance_to_box(const Kernel::Point_3& p, const CGAL::Bbox
 }
 
 // Closest-point search over CGAL's tree with CGAL's point-triangle projection, driven by
-// AABB_tree::traversal_with_priority (an internal but stable member in CGAL 5.x). It finds the
-// same closest point as AABB_tree::closest_point_and_primitive, with less work: CGAL's own
-// traits visit both children in a fixed order, test every box by constructing a sphere, and
-// project every triangle of a leaf pair; here the nearer child is visited first, boxes are
-// tested by their squared distance, and a triangle whose bounding box is already further than
-// the best point so far is not projected. Profiling showed these two costs (projection 42%,
-// traversal 40%) as the whole query time.
+// AABB_tree::traversal_with_priority (marked internal, present throughout CGAL 5.x). It finds
+// the same distance as AABB_tree::closest_point_and_primitive (where two triangles are equally
+// close it may name the other one) with less work: CGAL's own traits visit both children in a
+// fixed order, test each box by constructing a sphere, and project every triangle of a leaf
+// pair; here the nearer child is visited first, boxes are tested by their squared distance,
+// and a triangle whose bounding box is already further than the best point so far is not
+// projected. On the 100k-vertex benchmark (bench/bench_compare.cpp) projections took 42% and
+// the traversal 40% of CGAL's query time; these traits halve it.
 class ClosestPointTraits {
  public:
   using Priority = double;  // minus the squared distance to the box: nearer first
@@ -86,9 +88,10 @@ class ClosestPointTraits {
   double best_d2_;
 };
 
-// Queries run in blocks of this many points. A block's first query starts from the tree's k-d
-// tree guess and each later one from the previous answer (consecutive points are close);
-// fixed blocks make the answers independent of how TBB schedules them.
+// Queries run in blocks of this many points. A block's first query starts from the guess of
+// the tree's k-d tree, each later one from the triangle of the previous answer (consecutive
+// points are close: samples are sorted by face, edges by vertex); fixed blocks make the answers
+// independent of how TBB schedules them.
 constexpr std::size_t kQueryBlock = 256;
 
 Kernel::Point_3 to_cgal(const Eigen::Vector3d& p) {
@@ -223,16 +226,17 @@ struct DistanceQuery::Impl {
     return traits.result();
   }
 
-  // Runs fn(point index, query point, CGAL answer) for every row of P, in fixed blocks (see kQueryBlock).
+  // Runs fn(point index, query point, CGAL answer) for the rows [first, last) of P, in fixed
+  // blocks (see kQueryBlock). With skip_at_most >= 0, a point whose first guess is already
+  // within that squared distance is skipped (its distance cannot exceed it): for maxima.
   template <class Fn>
-  void for_each_closest(const Vertices& P, Fn&& fn) const {
-    const auto n = static_cast<std::size_t>(P.rows());
-    const std::size_t blocks = (n + kQueryBlock - 1) / kQueryBlock;
+  void for_each_closest(const Vertices& P, std::size_t first, std::size_t last, double skip_at_most, Fn&& fn) const {
+    const std::size_t blocks = (last - first + kQueryBlock - 1) / kQueryBlock;
     tbb::parallel_for(
         tbb::blocked_range<std::size_t>(0, blocks, 1),
         [&](const tbb::blocked_range<std::size_t>& range) {
           for (std::size_t block = range.begin(); block != range.end(); ++block) {
-            const std::size_t begin = block * kQueryBlock, end = std::min(n, begin + kQueryBlock);
+            const std::size_t begin = first + block * kQueryBlock, end = std::min(last, begin + kQueryBlock);
             Tree::Point_and_primitive_id hint;
             for (std::size_t i = begin; i < end; ++i) {
               const Kernel::Point_3 q = to_cgal(P.row(static_cast<Eigen::Index>(i)).transpose());
@@ -243,12 +247,18 @@ struct DistanceQuery::Impl {
                 // first bound than the previous closest point itself.
                 hint.first = Kernel().construct_projected_point_3_object()(*hint.second, q);
               }
+              if (skip_at_most >= 0 && CGAL::squared_distance(q, hint.first) <= skip_at_most) continue;
               hint = closest(q, hint);
               fn(i, q, hint);
             }
           }
         },
         tbb::simple_partitioner());
+  }
+
+  template <class Fn>
+  void for_each_closest(const Vertices& P, Fn&& fn) const {
+    for_each_closest(P, 0, static_cast<std::size_t>(P.rows()), -1.0, std::forward<Fn>(fn));
   }
 
   ClosestPoint make_answer(const Kernel::Point_3& q, const Tree::Point_and_primitive_id& answer) const {
@@ -308,20 +318,42 @@ Eigen::VectorXd DistanceQuery::squared_distances(const Vertices& P) const {
   return out;
 }
 
+double DistanceQuery::max_squared_distance(const Vertices& P, Index first_row, double at_least) const {
+  if (first_row < 0 || first_row > P.rows()) throw std::invalid_argument("max_squared_distance: first row out of range");
+  const auto first = static_cast<std::size_t>(first_row), last = static_cast<std::size_t>(P.rows());
+  // One slot per block (a block runs on one thread at a time); the maximum does not depend on
+  // the order of the slots.
+  std::vector<double> block_max((last - first + kQueryBlock - 1) / kQueryBlock, at_least);
+  impl_->for_each_closest(P, first, last, std::max(at_least, 0.0),
+                          [&](std::size_t i, const Kernel::Point_3& q, const Tree::Point_and_primitive_id& a) {
+                            double& slot = block_max[(i - first) / kQueryBlock];
+                            slot = std::max(slot, CGAL::squared_distance(q, a.first));
+                          });
+  return std::accumulate(block_max.begin(), block_max.end(), at_least,
+                         [](double a, double b) { return std::max(a, b); });
+}
+
 // ---------------------------------------------------------------------------------------------
 // Statistics
 
 DistanceStats one_sided_distance(const SurfaceSamples& a, const DistanceQuery& b) {
   DistanceStats s;
-  const Eigen::VectorXd d2 = b.squared_distances(a.points);
-  s.points = static_cast<Index>(d2.size());
-  if (d2.size() == 0) return s;
-  // Sums in index order (Eigen's reductions are deterministic for a given build).
-  const Eigen::Index n = a.num_area_samples > 0 ? a.num_area_samples : d2.size();
-  const auto area = d2.head(n);
-  s.mean = area.cwiseSqrt().mean();
-  s.rms = std::sqrt(area.mean());
-  s.max = std::sqrt(d2.maxCoeff());
+  s.points = static_cast<Index>(a.points.rows());
+  if (a.points.rows() == 0) return s;
+  if (a.num_area_samples == 0) {  // no area samples: every figure over all points
+    const Eigen::VectorXd d2 = b.squared_distances(a.points);
+    s.mean = d2.cwiseSqrt().mean();
+    s.rms = std::sqrt(d2.mean());
+    s.max = std::sqrt(d2.maxCoeff());
+    return s;
+  }
+  // Mean and RMS from the area samples (sums in index order, so the same for any thread
+  // count); the vertices and edge midpoints only matter where they exceed the samples' maximum.
+  const Vertices area = a.points.topRows(a.num_area_samples);
+  const Eigen::VectorXd d2 = b.squared_distances(area);
+  s.mean = d2.cwiseSqrt().mean();
+  s.rms = std::sqrt(d2.mean());
+  s.max = std::sqrt(b.max_squared_distance(a.points, a.num_area_samples, d2.maxCoeff()));
   return s;
 }
 
