@@ -115,6 +115,28 @@ TEST(SurfaceCurvatureAt, InterpolatesLinearFieldsExactly) {
                std::invalid_argument);
 }
 
+// The tensor overload of edge_error_stats is the Curvature overload with K_i spelled out, and
+// the trace of K_i is |k1| + |k2|.
+TEST(EdgeErrorStats, TensorsAgreeWithCurvature) {
+  const Mesh torus = test::torus(1.0, 0.3, 30, 12);
+  const Topology topology = build_topology(torus.F, torus.num_vertices());
+  const Curvature c = principal_curvatures(torus.V, torus.F, topology);
+  std::vector<Eigen::Matrix3d> tensors;
+  for (Index i = 0; i < torus.num_vertices(); ++i) {
+    tensors.push_back(c.absolute_tensor(i));
+    ASSERT_NEAR(tensors.back().trace(), c.absolute_sum()[i], 1e-12);
+  }
+  Mesh moved = torus;
+  moved.V.col(0) *= 1.1;
+  const EdgeErrorStats a = edge_error_stats(moved.V, topology, c), b = edge_error_stats(moved.V, topology, tensors);
+  EXPECT_NEAR(a.mean, b.mean, 1e-12 * a.mean);
+  EXPECT_NEAR(a.max_over_mean, b.max_over_mean, 1e-12);
+  EXPECT_NEAR(a.coefficient_of_variation, b.coefficient_of_variation, 1e-12);
+  EXPECT_GT(a.coefficient_of_variation, 0.1);  // a torus' edges have different errors
+  tensors.pop_back();
+  EXPECT_THROW(edge_error_stats(moved.V, topology, tensors), std::invalid_argument);
+}
+
 // A sphere of radius R as the reference: wherever a coarser sphere's vertex projects, the
 // surface has |k1| + |k2| = 2 / R and K = (I - n n^T) / R, so delta_e = |e_t|^2 / (8 R) with the
 // tangential part of e. The reference's interpolated values must give nearly that.
