@@ -1,6 +1,7 @@
 #include "report_support.h"
 
 #include "cli_common.h"
+#include "vertexflow/compare.h"
 #include "vertexflow/curvature.h"
 #include "vertexflow/flow.h"
 #include "vertexflow/metrics.h"
@@ -13,27 +14,41 @@
 namespace vertexflow::cli {
 
 nlohmann::json flow_metrics(const Vertices& input, const Vertices& result, const Faces& F) {
-  const Topology topology = build_topology(F, static_cast<Index>(input.rows()));
-  const Curvature surface = principal_curvatures(input, F, topology);
-  const Eigen::VectorXd magnitude = surface.absolute_sum();
-  const EdgeErrorStats before = edge_error_stats(input, topology, surface);
-  const EdgeErrorStats after = edge_error_stats(result, topology, surface);
+  // The definitions of metrics.md, through the same function as `vertexflow compare`: rho and
+  // the edge-error CV use the input surface's curvature at each vertex's current position.
+  Mesh input_mesh, result_mesh;
+  input_mesh.V = input;
+  input_mesh.F = F;
+  result_mesh.V = result;
+  result_mesh.F = F;
+  const MeshComparison c = compare_meshes(result_mesh, input_mesh, nullptr);
   // The flow's own unit (FlowReport::mean_edge_length is the same number).
-  const double edge = mean_edge_length(input, topology);
-  const Eigen::VectorXd moved = (result - input).rowwise().norm() / (edge > 0 ? edge : 1.0);
+  const double edge = mean_edge_length(input, build_topology(F, static_cast<Index>(input.rows())));
+  const double unit = edge > 0 ? edge : 1.0;
+  const Eigen::VectorXd moved = (result - input).rowwise().norm() / unit;
   const double volume_before = signed_volume(input, F);
   nlohmann::json report;
   report["vertices"] = input.rows();
   report["faces"] = F.rows();
-  report["flipped_faces"] = flipped_faces(input, result, F).size();
-  report["degenerate_faces"] = degenerate_faces(result, F).size();
-  report["quality_input"] = to_json(summarize_quality(triangle_quality(input, F)));
-  report["quality_result"] = to_json(summarize_quality(triangle_quality(result, F)));
+  report["flipped_faces"] = c.flipped_faces.value_or(0);
+  report["degenerate_faces"] = c.degenerate_faces_result;
+  report["quality_input"] = to_json(c.quality_input);
+  report["quality_result"] = to_json(c.quality_result);
   report["displacement_edge_lengths"] = {{"mean", moved.size() ? moved.mean() : 0.0},
                                          {"max", moved.size() ? moved.maxCoeff() : 0.0}};
-  report["redistribution_rho"] = {{"input", redistribution_rho(magnitude, input, F)},
-                                  {"result", redistribution_rho(magnitude, result, F)}};
-  report["edge_error_cv"] = {{"input", before.coefficient_of_variation}, {"result", after.coefficient_of_variation}};
+  // Drift: how far the result's surface strayed from the input's, in mean input edge lengths.
+  const DistanceStats& drift = c.result_input.a_to_b;
+  report["drift_edge_lengths"] = {{"mean", drift.mean / unit},
+                                  {"rms", drift.rms / unit},
+                                  {"max", drift.max / unit},
+                                  {"hausdorff", c.result_input.hausdorff / unit}};
+  report["redistribution_rho"] = {{"input", c.redistribution_rho_input}, {"result", c.redistribution_rho_result}};
+  report["edge_error_cv"] = {{"input", c.edge_error_input.coefficient_of_variation},
+                             {"result", c.edge_error_result.coefficient_of_variation}};
+  report["edge_error_max_over_mean"] = {{"input", c.edge_error_input.max_over_mean},
+                                        {"result", c.edge_error_result.max_over_mean}};
+  report["abs_mean_curvature_p95"] = {{"input", c.abs_mean_curvature_input.p95},
+                                      {"result", c.abs_mean_curvature_result.p95}};
   report["volume_change_percent"] =
       volume_before != 0 ? 100.0 * (signed_volume(result, F) - volume_before) / std::abs(volume_before) : 0.0;
   return report;

@@ -29,6 +29,7 @@ class Runner:
         self.samples = samples
         self.repeats = repeats
         self.commands = []
+        self.figures = None
 
     def run(self, *args, capture=True):
         command = [self.cli, "-q", *map(str, args)]
@@ -68,6 +69,13 @@ class Runner:
         if not out.exists():  # the slowest step, and deterministic: reuse between runs
             self.run("remesh", source, out, "--target-vertices", vertices, "--force")
         return out
+
+    def render(self, mesh, png, *options):
+        """Renders to docs/figures/<png> and returns the markdown-relative path and the colour range."""
+        self.figures.mkdir(parents=True, exist_ok=True)
+        out = self.figures / png
+        info = json.loads(self.run("render", mesh, out, "--size", "800x600", "--json", "--force", *options))
+        return f"figures/{png}", info
 
     def info(self, mesh):
         return json.loads(self.run("info", mesh, "--json"))
@@ -121,6 +129,7 @@ def main():
     work = ROOT / "build" / "results"
     work.mkdir(parents=True, exist_ok=True)
     r = Runner(args.cli, work, args.samples, args.repeats)
+    r.figures = Path(args.out) / "figures"
     data = ROOT / "data"
     results = {"machine": machine(), "date": datetime.date.today().isoformat(), "samples": args.samples,
                "repeats": args.repeats}
@@ -161,6 +170,12 @@ def main():
                          "hausdorff": c["distance"]["result_input"]["hausdorff"] / e,
                          "flips": c["flipped_faces"]["count"], "volume_change_percent": rep["volume_change_percent"]})
     results["fig4_lambda"] = fig4
+    fig4_images = []
+    for lam in (None, 0.2, 1, 10, 50):
+        mesh = data / "bunny_uniform.off" if lam is None else r.path(f"fig4-bunny_uniform.off-{lam}.ply")
+        image, _ = r.render(mesh, f"fig4-bunny-{'input' if lam is None else lam}.png", "--wireframe", "--view",
+                            "front", "--frame-from", data / "bunny_uniform.off", "--no-colorbar")
+        fig4_images.append((("input" if lam is None else f"lambda {lam}"), image))
     md += ["## Fig. 4: the strength knob lambda", "",
            "Displacement and distances in mean edge lengths of the input; rho = Spearman(surface |k1|+|k2|, "
            "vertex density); CV = coefficient of variation of the per-edge error (docs: metrics.md).", "",
@@ -169,7 +184,9 @@ def main():
                  [[f["mesh"], f["lambda"], fmt(f["displacement"]), f"{fmt(f['rho_input'])} -> {fmt(f['rho'])}",
                    f"{fmt(f['cv_input'])} -> {fmt(f['cv'])} ({100 * (f['cv'] / f['cv_input'] - 1):+.1f}%)",
                    fmt(f["distance_mean"]), fmt(f["hausdorff"]), f["flips"], fmt(f["volume_change_percent"])]
-                  for f in fig4]), ""]
+                  for f in fig4]), "",
+           " ".join(f"![{label}]({image})" for label, image in fig4_images),
+           "", "bunny_uniform: the input, then lambda = 0.2, 1, 10, 50 (same camera).", ""]
 
     # Fig. 5: mu sweep, quality histograms.
     fig5 = []
@@ -179,6 +196,12 @@ def main():
             fig5.append({"mesh": name, "mu": mu, "quality_input": rep["quality_input"],
                          "quality": rep["quality_result"]})
     results["fig5_mu"] = fig5
+    fig5_images = []
+    for mu in (None, 0, 0.5, 1):
+        mesh = data / "fandisk.off" if mu is None else r.path(f"fig5-fandisk.off-{mu}.ply")
+        image, _ = r.render(mesh, f"fig5-fandisk-{'input' if mu is None else mu}.png", "--color", "quality",
+                            "--wireframe", "--flat", "--frame-from", data / "fandisk.off")
+        fig5_images.append((("input" if mu is None else f"mu {mu}"), image))
     md += ["## Fig. 5: the fairness weight mu and triangle quality", "",
            "Radius ratio 2r/R; histogram of 10 bins over [0, 1] (counts, lowest bin first).", "",
            table(["mesh", "mu", "min", "mean", "below 0.3", "histogram"],
@@ -187,7 +210,9 @@ def main():
                   for f in fig5 if f["mu"] == 0] +
                  [[f["mesh"], f["mu"], fmt(f["quality"]["min"]), fmt(f["quality"]["mean"]),
                    fmt(f["quality"]["fraction_below_0_3"]), " ".join(map(str, f["quality"]["histogram"]))]
-                  for f in fig5]), ""]
+                  for f in fig5]), "",
+           " ".join(f"![{label}]({image})" for label, image in fig5_images),
+           "", "fandisk coloured by triangle quality (red = poor): the input, then mu = 0, 0.5, 1.", ""]
 
     # Fig. 10: mean-curvature percentiles before/after.
     fig10 = []
@@ -197,10 +222,20 @@ def main():
         fig10.append({"mesh": name, "input": c["abs_mean_curvature"]["input"],
                       "result": c["abs_mean_curvature"]["result"]})
     results["fig10_mean_curvature"] = fig10
+    fig10_images = []
+    for name in ("bunny_uniform.off", "max-planck-5k.obj"):
+        before, info = r.render(data / name, f"fig10-{name}-input.png", "--color", "mean", "--view", "front")
+        limit = max(abs(info["color"]["min"]), abs(info["color"]["max"])) or 1.0
+        after, _ = r.render(r.path(f"fig10-{name}.ply"), f"fig10-{name}-result.png", "--color", "mean", "--view",
+                            "front", "--frame-from", data / name, "--range", limit)
+        fig10_images.append((name, before, after))
     md += ["## Fig. 10: feature prominence, |H| percentiles (same estimator on both)", "",
            table(["mesh", "p5 in -> out", "p50 in -> out", "p95 in -> out", "p99 in -> out"],
                  [[f["mesh"]] + [f"{fmt(f['input'][p])} -> {fmt(f['result'][p])}" for p in ("p5", "p50", "p95", "p99")]
-                  for f in fig10]), ""]
+                  for f in fig10]), "",
+           "\n\n".join(f"![{n} input]({b}) ![{n} result]({a})" for n, b, a in fig10_images),
+           "", "Mean curvature (red positive, blue negative, the same colour range before and after): input "
+           "left, result right.", ""]
 
     # Fig. 12 and Fig. 8: coarse inputs remeshed from dense references.
     fig12, fig8, pmp = [], [], []
@@ -232,6 +267,11 @@ def main():
             row["gain_mean"] = row["without"]["mean"] / row["with"]["mean"]
             fig12.append(row)
     results["fig12_lod"] = fig12
+    fig12_images = []
+    for label in ("without", "with"):
+        image, _ = r.render(r.path(f"lod-bunny-{label}-0.1.ply"), f"fig12-bunny-{label}.png", "--wireframe",
+                            "--flat", "--view", "front", "--frame-from", data / "bunny.off", "--no-colorbar")
+        fig12_images.append((label, image))
     results["fig8_unsharp"] = fig8
 
     # Flow vs PMP's adaptive remeshing at equal vertex count.
@@ -260,6 +300,9 @@ def main():
                  [[f["mesh"], f"{f['faces']} ({int(f['fraction'] * 100)}%)", fmt(f["without"]["hausdorff"]),
                    fmt(f["with"]["hausdorff"]), fmt(f["gain_hausdorff"]), fmt(f["without"]["mean"]),
                    fmt(f["with"]["mean"]), fmt(f["gain_mean"])] for f in fig12]), "",
+           " ".join(f"![{label} the flow]({image})" for label, image in fig12_images), "",
+           "bunny remeshed to about 6000 vertices, then QEM to 10% of its faces: without the flow (left), "
+           "after the flow (right).", "",
            "## Fig. 8: vertex flow against the geometric unsharp mask", "",
            "Same coarse inputs; distances to the dense mesh (relative to its diagonal).", "",
            table(["mesh", "method", "mean distance (input -> result)", "Hausdorff", "rho in -> out",

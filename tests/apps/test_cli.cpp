@@ -149,6 +149,8 @@ TEST(CliEnhance, WritesTheMeshAndAReport) {
   // The flow redistributes vertices towards curved regions and evens out the edge errors.
   EXPECT_GT(j["redistribution_rho"]["result"].get<double>(), j["redistribution_rho"]["input"].get<double>() + 0.2);
   EXPECT_LT(j["edge_error_cv"]["result"].get<double>(), 0.95 * j["edge_error_cv"]["input"].get<double>());
+  EXPECT_LT(j["drift_edge_lengths"]["mean"].get<double>(), 0.05);
+  EXPECT_GE(j["drift_edge_lengths"]["hausdorff"].get<double>(), j["drift_edge_lengths"]["max"].get<double>());
   for (const char* phase : {"read", "curvature", "assembly", "solve", "guard", "write"})
     EXPECT_GE(j["seconds"][phase].get<double>(), 0.0) << phase;
 }

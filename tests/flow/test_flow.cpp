@@ -3,6 +3,7 @@
 #include "shapes.h"
 #include "test_support.h"
 
+#include "vertexflow/distance.h"
 #include "vertexflow/flow.h"
 #include "vertexflow/io.h"
 #include "vertexflow/quality.h"
@@ -35,6 +36,12 @@ void expect_flow_guarantees(const Mesh& mesh, const FlowResult& result, bool che
       ASSERT_EQ(result.V.row(v), mesh.V.row(v)) << v;
     }
   }
+  // Drift (issue 4): mean distance from the result's surface to the input's <= 0.05 mean edge
+  // lengths (area samples, exact distances: distance.h).
+  SamplingOptions sampling;
+  sampling.samples = 50000;
+  const double drift = one_sided_distance(result.V, mesh.F, mesh.V, mesh.F, sampling).mean;
+  EXPECT_LE(drift, 0.05 * result.report.mean_edge_length);
   if (check_volume && topology.is_closed()) {
     const double before = signed_volume(mesh.V, mesh.F), after = signed_volume(result.V, mesh.F);
     EXPECT_LT(std::abs(after - before), 0.005 * std::abs(before));
