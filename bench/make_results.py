@@ -223,11 +223,13 @@ def main():
                       "result": c["abs_mean_curvature"]["result"]})
     results["fig10_mean_curvature"] = fig10
     fig10_images = []
-    for name in ("bunny_uniform.off", "max-planck-5k.obj"):
-        before, info = r.render(data / name, f"fig10-{name}-input.png", "--color", "mean", "--view", "front")
+    # max-planck-5k looks along -z: view it from the custom azimuth 180.
+    for name, view in (("bunny_uniform.off", ["--view", "front"]),
+                       ("max-planck-5k.obj", ["--view", "custom", "--azimuth", "180", "--elevation", "0"])):
+        before, info = r.render(data / name, f"fig10-{name}-input.png", "--color", "mean", *view)
         limit = max(abs(info["color"]["min"]), abs(info["color"]["max"])) or 1.0
-        after, _ = r.render(r.path(f"fig10-{name}.ply"), f"fig10-{name}-result.png", "--color", "mean", "--view",
-                            "front", "--frame-from", data / name, "--range", limit)
+        after, _ = r.render(r.path(f"fig10-{name}.ply"), f"fig10-{name}-result.png", "--color", "mean", *view,
+                            "--frame-from", data / name, "--range", limit)
         fig10_images.append((name, before, after))
     md += ["## Fig. 10: feature prominence, |H| percentiles (same estimator on both)", "",
            table(["mesh", "p5 in -> out", "p50 in -> out", "p95 in -> out", "p99 in -> out"],
