@@ -23,6 +23,7 @@ packages=(
   libbenchmark-dev
   clang libclang-rt-14-dev # libFuzzer targets and sanitizers
   clang-format
+  python3                  # bench/make_results.py (docs/results.md)
   chromium chromium-driver # headless browser test of the HTML report (tests/CMakeLists.txt)
 )
 
