@@ -5,8 +5,7 @@
 
 #include "vertexflow/flow.h"
 #include "vertexflow/html_report.h"
-#include "vertexflow/metrics.h"
-#include "vertexflow/quality.h"
+#include "vertexflow/timing.h"
 #include "vertexflow/unsharp.h"
 
 #include <fmt/format.h>
@@ -57,10 +56,6 @@ std::vector<Index> read_pins(const std::string& path, Index num_vertices) {
     }
   }
   return pins;
-}
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
 // The unsharp-mask baseline (unsharp.h) in the flow's result type, so that both methods share

@@ -7,6 +7,7 @@
 #include "vertexflow/flow_energy.h"
 #include "vertexflow/quality.h"
 #include "vertexflow/statistics.h"
+#include "vertexflow/timing.h"
 #include "vertexflow/topology.h"
 
 #include <tbb/blocked_range.h>
@@ -20,11 +21,6 @@
 
 namespace vertexflow {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 // The radius d of Eq. 6: 1 / (percentile of the largest |k| per vertex).
 double robust_radius(const Curvature& c, double at_percentile) {

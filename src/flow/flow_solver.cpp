@@ -35,6 +35,8 @@
 // counts, so the output bytes do not depend on timings or thread counts.
 #include "flow_solver.h"
 
+#include "vertexflow/timing.h"
+
 #include <cholmod.h>
 #include <dlfcn.h>
 #include <tbb/blocked_range.h>
@@ -52,11 +54,6 @@
 
 namespace vertexflow {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 using Matrix3 = Eigen::Matrix3d;
 using Vector3 = Eigen::Vector3d;

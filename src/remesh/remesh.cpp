@@ -3,6 +3,7 @@
 #include "vertexflow/remesh.h"
 
 #include "surface_mesh_conversion.h"
+#include "vertexflow/timing.h"
 
 #include <CGAL/Polygon_mesh_processing/remesh.h>
 #include <fmt/format.h>
@@ -20,10 +21,6 @@ namespace {
 
 namespace PMP = CGAL::Polygon_mesh_processing;
 using remesh_detail::SurfaceMesh;
-
-double seconds_since(std::chrono::steady_clock::time_point start) {
-  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-}
 
 void check_options(const IsotropicRemeshOptions& options) {
   if (options.iterations < 1) throw std::invalid_argument("remesh: iterations must be at least 1");

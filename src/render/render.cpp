@@ -9,6 +9,7 @@
 #include "vertexflow/curvature.h"
 #include "vertexflow/io.h"
 #include "vertexflow/quality.h"
+#include "vertexflow/timing.h"
 #include "vertexflow/topology.h"
 
 #define GL_GLEXT_PROTOTYPES
@@ -33,12 +34,6 @@
 
 namespace vertexflow {
 namespace {
-
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 // How a quantity becomes a colour: diverging_colors((value - offset) * sign, limit), shown on
 // the bar for values in [lo, hi]. Quality uses offset 1, sign -1 so that q = 1 is white, 0 red.
