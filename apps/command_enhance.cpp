@@ -170,8 +170,10 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     const FlowReport& r = result.report;
     if (!unsharp)
       phase(fmt::format(
-          "curvature {:.3f} s, assembly {:.3f} s, solve {:.3f} s, guard {:.3f} s; {} vertices limited by the guard",
-          r.seconds_curvature, r.seconds_assembly, r.seconds_solve, r.seconds_guard, r.limited_vertices));
+          "curvature {:.3f} s, assembly {:.3f} s, solve {:.3f} s, projection {:.3f} s, guard {:.3f} s; {} vertices "
+          "limited by the guard",
+          r.seconds_curvature, r.seconds_assembly, r.seconds_solve, r.seconds_projection, r.seconds_guard,
+          r.limited_vertices));
 
     // Same connectivity and colours; per-vertex properties of the input (say, curvature from an
     // earlier run) no longer describe the moved vertices and are not carried over.
