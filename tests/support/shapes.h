@@ -22,12 +22,6 @@ Mesh torus(double R, double r, int around, int tube);
 /// The saddle z = (x^2 - y^2) / 2 over [-half, half]^2, n x n quads; normals up (+z).
 Mesh saddle(double half, int n);
 
-/// Distance from p to the triangle (a, b, c), by Ericson's region tests ("Real-Time Collision
-/// Detection", 5.1.5): written here, independent of the library's CGAL-based queries, so tests
-/// can check those against it by brute force.
-double point_triangle_distance(const Eigen::Vector3d& p, const Eigen::Vector3d& a, const Eigen::Vector3d& b,
-                               const Eigen::Vector3d& c);
-
 /// A thin perforated plate, a hard case for the flow (thin walls, sharp creases, high genus):
 /// (2 holes + 1)^2 unit cells in the xy-plane, every cell with odd row and column a square
 /// through-hole, `thickness` thick in z, each cell cut into `subdivisions`^2 quads (two
