@@ -198,11 +198,7 @@ TEST(Flow, LargerLambdaMovesLess) {
 }
 
 TEST(Flow, RefusesNonManifoldAndEmptyMeshes) {
-  Mesh bowtie;
-  bowtie.V.resize(5, 3);
-  bowtie.V << 0, 0, 0, 1, 0, 0, 0, 1, 0, -1, 0, 0, 0, -1, 0;
-  bowtie.F.resize(2, 3);
-  bowtie.F << 0, 1, 2, 0, 3, 4;
+  const Mesh bowtie = test::bowtie();
   EXPECT_THROW(vertex_flow(bowtie.V, bowtie.F), std::invalid_argument);
   EXPECT_THROW(vertex_flow(Vertices(), Faces()), std::invalid_argument);
 }

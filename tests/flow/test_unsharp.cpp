@@ -166,11 +166,7 @@ TEST(Unsharp, InvariantUnderRigidMotionAndUniformScale) {
 }
 
 TEST(Unsharp, BadInputIsRefused) {
-  Mesh bowtie;
-  bowtie.V.resize(5, 3);
-  bowtie.V << 0, 0, 0, 1, 0, 0, 0, 1, 0, -1, 0, 0, 0, -1, 0;
-  bowtie.F.resize(2, 3);
-  bowtie.F << 0, 1, 2, 0, 3, 4;
+  const Mesh bowtie = test::bowtie();
   try {
     unsharp_mask(bowtie.V, bowtie.F);
     FAIL() << "non-manifold mesh accepted";

@@ -176,11 +176,7 @@ TEST(CompareMeshes, UsesTheReferenceCurvatureAtTheClosestPoints) {
 
 TEST(CompareMeshes, RejectsNonManifoldAndEmptyMeshesNamingThem) {
   const Mesh good = test::icosphere(1.0, 1);
-  Mesh bowtie;
-  bowtie.V.resize(5, 3);
-  bowtie.V << 0, 0, 0, 1, 0, 0, 0, 1, 0, -1, 0, 0, 0, -1, 0;
-  bowtie.F.resize(2, 3);
-  bowtie.F << 0, 1, 2, 0, 3, 4;
+  const Mesh bowtie = test::bowtie();
   try {
     compare_meshes(good, good, &bowtie);
     ADD_FAILURE() << "no error";

@@ -49,16 +49,6 @@ double segment_distance(const Eigen::RowVector3d& p, const Eigen::RowVector3d& a
   return (p - (a + t * ab)).norm();
 }
 
-void expect_same_topology(const Mesh& input, const Mesh& output) {
-  const Topology before = build_topology(input.F, input.num_vertices());
-  const Topology after = build_topology(output.F, output.num_vertices());
-  EXPECT_TRUE(after.is_manifold());
-  EXPECT_TRUE(after.is_oriented);
-  EXPECT_EQ(after.genus(), before.genus());
-  EXPECT_EQ(after.num_components, before.num_components);
-  EXPECT_EQ(after.boundary_loops.size(), before.boundary_loops.size());
-}
-
 TEST(Remesh, EdgeLengthForVertexCountCoversTheArea) {
   // N vertices of a closed mesh give ~2N equilateral triangles of side L: 2N (sqrt3/4) L^2 = A.
   for (const double area : {1.0, 12.566, 3e4}) {
@@ -91,7 +81,7 @@ TEST(Remesh, BunnyLandsWithinTheToleranceOnTheSurface) {
   EXPECT_GT(quality.p5, 0.85);
   EXPECT_EQ(quality.fraction_below_0_3, 0.0);
   EXPECT_GT(quality.min, 0.4);
-  expect_same_topology(bunny, result.mesh);
+  test::expect_same_topology(bunny, result.mesh);
 }
 
 TEST(Remesh, KeepsGenusAndComponents) {
@@ -102,7 +92,7 @@ TEST(Remesh, KeepsGenusAndComponents) {
     options.target_vertices = target;
     const RemeshResult result = remesh_to_vertex_count(mesh.V, mesh.F, options);
     EXPECT_TRUE(result.report.within_tolerance) << result.mesh.num_vertices();
-    expect_same_topology(mesh, result.mesh);
+    test::expect_same_topology(mesh, result.mesh);
     EXPECT_LT(max_distance_to_surface(result.mesh.V, mesh), 1e-9 * bounding_box(mesh.V).diagonal());
   }
 }
@@ -136,7 +126,7 @@ TEST(Remesh, SearchCorrectsTheEdgeLengthAndKeepsTheClosestRun) {
   options.target_vertices = 8000;
   const RemeshResult up = remesh_to_vertex_count(spot.V, spot.F, options);
   EXPECT_TRUE(up.report.within_tolerance) << up.mesh.num_vertices();
-  expect_same_topology(spot, up.mesh);
+  test::expect_same_topology(spot, up.mesh);
 }
 
 TEST(Remesh, BoundaryIsResampledAlongTheInputBoundary) {
@@ -147,7 +137,7 @@ TEST(Remesh, BoundaryIsResampledAlongTheInputBoundary) {
   options.target_vertices = 500;
   const RemeshResult result = remesh_to_vertex_count(hemisphere.V, hemisphere.F, options);
   EXPECT_TRUE(result.report.within_tolerance) << result.mesh.num_vertices();
-  expect_same_topology(hemisphere, result.mesh);
+  test::expect_same_topology(hemisphere, result.mesh);
   const Topology output = build_topology(result.mesh.F, result.mesh.num_vertices());
   const double diagonal = bounding_box(hemisphere.V).diagonal();
   double worst = 0;
@@ -207,15 +197,11 @@ TEST(Remesh, FixedEdgeLengthGivesEdgesNearIt) {
   const Eigen::VectorXd radius = result.V.rowwise().norm();
   EXPECT_LT(radius.maxCoeff(), 1.0 + 1e-12);
   EXPECT_GT(radius.minCoeff(), inner - 1e-12);
-  expect_same_topology(sphere, result);
+  test::expect_same_topology(sphere, result);
 }
 
 TEST(Remesh, RefusesBadInputAndOptions) {
-  Mesh bowtie;
-  bowtie.V.resize(5, 3);
-  bowtie.V << 0, 0, 0, 1, 0, 0, 0, 1, 0, -1, 0, 0, 0, -1, 0;
-  bowtie.F.resize(2, 3);
-  bowtie.F << 0, 1, 2, 0, 3, 4;
+  const Mesh bowtie = test::bowtie();
   try {
     remesh_to_vertex_count(bowtie.V, bowtie.F);
     FAIL() << "non-manifold mesh accepted";

@@ -27,17 +27,6 @@ std::set<Point> boundary_points(const Mesh& mesh) {
   return points;
 }
 
-// Manifold, oriented, and the same genus, components and boundary loops as the input.
-void expect_same_topology(const Mesh& input, const Mesh& output) {
-  const Topology before = build_topology(input.F, input.num_vertices());
-  const Topology after = build_topology(output.F, output.num_vertices());
-  EXPECT_TRUE(after.is_manifold());
-  EXPECT_TRUE(after.is_oriented);
-  EXPECT_EQ(after.genus(), before.genus());
-  EXPECT_EQ(after.num_components, before.num_components);
-  EXPECT_EQ(after.boundary_loops.size(), before.boundary_loops.size());
-}
-
 TEST(Simplify, HitsTheFaceBudgetWithinOneFace) {
   const Mesh spot = read_mesh(test::data_path("spot.obj"));
   for (const Index target : {4000, 1001, 1000, 200}) {
@@ -52,7 +41,7 @@ TEST(Simplify, HitsTheFaceBudgetWithinOneFace) {
     // A closed mesh loses one vertex and two faces per collapse.
     EXPECT_EQ(result.report.collapses, spot.num_vertices() - result.mesh.num_vertices());
     EXPECT_EQ(2 * result.report.collapses, spot.num_faces() - result.mesh.num_faces());
-    expect_same_topology(spot, result.mesh);
+    test::expect_same_topology(spot, result.mesh);
   }
   SimplifyOptions ratio;
   ratio.target_ratio = 0.25;
@@ -68,7 +57,7 @@ TEST(Simplify, KeepsGenusAndComponents) {
     options.target_ratio = 0.2;
     const SimplifyResult result = simplify(mesh.V, mesh.F, options);
     SCOPED_TRACE(name);
-    expect_same_topology(mesh, result.mesh);
+    test::expect_same_topology(mesh, result.mesh);
     EXPECT_LE(result.mesh.num_faces(), result.report.target_faces + 1);
   }
 }
@@ -84,7 +73,7 @@ TEST(Simplify, BoundaryLoopsKeepEveryVertexExactly) {
     EXPECT_EQ(boundary_points(result.mesh), before);  // same positions, bit for bit, none lost
     // The interior still collapsed down to the budget.
     EXPECT_LE(result.mesh.num_faces(), result.report.target_faces + 1);
-    expect_same_topology(mesh, result.mesh);
+    test::expect_same_topology(mesh, result.mesh);
   }
 }
 
@@ -107,7 +96,7 @@ TEST(Simplify, SphereStaysCloseToTheSphere) {
   std::cout << "sphere: max radial deviation " << deviation << ", longest edge " << longest << "\n";
   EXPECT_LT(deviation, longest * longest / 2);
   EXPECT_LT(deviation, 0.01);  // in absolute terms: 1% of the radius
-  expect_same_topology(sphere, result.mesh);
+  test::expect_same_topology(sphere, result.mesh);
 }
 
 // Collapses inside a plane cost nothing, so a flat square grid collapses down to (almost) the
@@ -160,11 +149,7 @@ TEST(Simplify, BudgetAtOrAboveTheInputChangesNothing) {
 }
 
 TEST(Simplify, RefusesWhatAHalfedgeMeshCannotHold) {
-  Mesh bowtie;
-  bowtie.V.resize(5, 3);
-  bowtie.V << 0, 0, 0, 1, 0, 0, 0, 1, 0, -1, 0, 0, 0, -1, 0;
-  bowtie.F.resize(2, 3);
-  bowtie.F << 0, 1, 2, 0, 3, 4;
+  const Mesh bowtie = test::bowtie();
   try {
     simplify(bowtie.V, bowtie.F);
     FAIL() << "non-manifold mesh accepted";

@@ -118,6 +118,15 @@ Mesh saddle(double half, int n) {
   return from_lists(p, f);
 }
 
+Mesh bowtie() {
+  Mesh mesh;
+  mesh.V.resize(5, 3);
+  mesh.V << 0, 0, 0, 1, 0, 0, 0, 1, 0, -1, 0, 0, 0, -1, 0;
+  mesh.F.resize(2, 3);
+  mesh.F << 0, 1, 2, 0, 3, 4;
+  return mesh;
+}
+
 Mesh perforated_plate(int holes, int subdivisions, double thickness, bool bottom) {
   const int cells = 2 * holes + 1, n = cells * subdivisions;  // lattice of (n + 1)^2 points
   std::vector<Eigen::Vector3d> p;

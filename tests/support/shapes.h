@@ -22,6 +22,9 @@ Mesh torus(double R, double r, int around, int tube);
 /// The saddle z = (x^2 - y^2) / 2 over [-half, half]^2, n x n quads; normals up (+z).
 Mesh saddle(double half, int n);
 
+/// Two triangles sharing only vertex 0 (a "bowtie"): the smallest non-manifold mesh.
+Mesh bowtie();
+
 /// A thin perforated plate, a hard case for the flow (thin walls, sharp creases, high genus):
 /// (2 holes + 1)^2 unit cells in the xy-plane, every cell with odd row and column a square
 /// through-hole, `thickness` thick in z, each cell cut into `subdivisions`^2 quads (two

@@ -1,5 +1,9 @@
 #include "test_support.h"
 
+#include "vertexflow/topology.h"
+
+#include <gtest/gtest.h>
+
 #include <sys/wait.h>
 #include <unistd.h>
 #include <cctype>
@@ -65,6 +69,16 @@ CommandResult run_command(const std::string& command) {
 
 CommandResult run_cli(const std::string& arguments) {
   return run_command(shell_quote(VERTEXFLOW_CLI) + " " + arguments);
+}
+
+void expect_same_topology(const Mesh& input, const Mesh& output) {
+  const Topology before = build_topology(input.F, input.num_vertices());
+  const Topology after = build_topology(output.F, output.num_vertices());
+  EXPECT_TRUE(after.is_manifold());
+  EXPECT_TRUE(after.is_oriented);
+  EXPECT_EQ(after.genus(), before.genus());
+  EXPECT_EQ(after.num_components, before.num_components);
+  EXPECT_EQ(after.boundary_loops.size(), before.boundary_loops.size());
 }
 
 }  // namespace vertexflow::test

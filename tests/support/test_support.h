@@ -1,6 +1,8 @@
 // Shared helpers for the tests: paths to bundled data and scratch directories.
 #pragma once
 
+#include "vertexflow/mesh.h"
+
 #include <filesystem>
 #include <string>
 
@@ -48,6 +50,10 @@ CommandResult run_cli(const std::string& arguments);
 
 /// Single-quotes a string for /bin/sh.
 std::string shell_quote(const std::string& s);
+
+/// Expects `output` to be manifold and oriented with the same genus, components and boundary
+/// loops as `input` (gtest assertions).
+void expect_same_topology(const Mesh& input, const Mesh& output);
 
 /// The whole content of a file (empty if it cannot be read).
 std::string read_text(const std::filesystem::path& path);
