@@ -1,7 +1,14 @@
 // Rusinkiewicz (2004) curvature estimation; see include/vertexflow/curvature.h for the
 // conventions. Every pass is either "per face, write own slots" or "per vertex, gather from
 // incident faces in the topology's fixed order", so results do not depend on thread count.
+//
+// The hot loops use a small scalar 3-vector (Vec3) rather than Eigen::Vector3d: for 3-vectors
+// Eigen's SSE packets (2 + 1 lanes) cost about 15% more instructions here (measured with
+// EIGEN_DONT_VECTORIZE under callgrind), and this function is a benchmark target (>= 5M
+// vertices/s, bench/bench_curvature.cpp). The small 3x3 solve stays Eigen's.
 #include "vertexflow/curvature.h"
+
+#include "common/huge_pages.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -9,6 +16,8 @@
 #include <Eigen/Dense>
 
 #include <cmath>
+#include <cstdint>
+#include <memory>
 #include <stdexcept>
 
 namespace vertexflow {
@@ -23,105 +32,186 @@ void parallel_range(Index n, Body&& body) {
   });
 }
 
-Eigen::Vector3d position(const Vertices& V, Index v) {
-  return V.row(v).transpose();
+struct Vec3 {
+  double x, y, z;
+};
+inline Vec3 operator+(Vec3 a, Vec3 b) { return {a.x + b.x, a.y + b.y, a.z + b.z}; }
+inline Vec3 operator-(Vec3 a, Vec3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+inline Vec3 operator-(Vec3 a) { return {-a.x, -a.y, -a.z}; }
+inline Vec3 operator*(double s, Vec3 a) { return {s * a.x, s * a.y, s * a.z}; }
+inline double dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+inline Vec3 cross(Vec3 a, Vec3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+inline double squared_norm(Vec3 a) { return dot(a, a); }
+
+inline Vec3 row(const Vertices& M, Index i) {
+  const double* p = M.data() + 3 * static_cast<std::ptrdiff_t>(i);
+  return {p[0], p[1], p[2]};
+}
+inline void set_row(Vertices& M, Index i, Vec3 a) {
+  double* p = M.data() + 3 * static_cast<std::ptrdiff_t>(i);
+  p[0] = a.x;
+  p[1] = a.y;
+  p[2] = a.z;
+}
+inline const Index* face_row(const Faces& F, Index f) { return F.data() + 3 * static_cast<std::ptrdiff_t>(f); }
+inline int corner_of(const Faces& F, Index f, Index v) {
+  const Index* face = face_row(F, f);
+  return face[0] == v ? 0 : face[1] == v ? 1 : 2;
 }
 
-// Per-face quantities: the (unnormalised) face normal n = (p1 - p0) x (p2 - p0), each
-// corner's weight in its vertex normal (the cross product of the two edges at every corner is
-// n, so a corner contributes weight * n), and each corner's mixed area (Meyer et al. 2003).
+// Per-face geometry for the vertex normals and areas: the unnormalised face normal
+// n = (p1 - p0) x (p2 - p0) (the cross product of the two edges at every corner), each
+// corner's weight in its vertex normal (it contributes weight * n) and each corner's mixed
+// area (Meyer et al. 2003). All zero for a degenerate face.
 struct FaceGeometry {
-  Eigen::Vector3d normal;
-  Eigen::Vector3d normal_weight;
-  Eigen::Vector3d corner_area;
+  Vec3 normal;
+  double weight[3];
+  double area[3];
 };
 
-// One pass over the face's three edge vectors d_k = p_{k+1} - p_k: at corner k the edges are
-// d_k and -d_{k+2}, so their dot product and squared lengths come from these three vectors, and
-// each weight or area needs no division of its own (this runs once per corner per vertex).
-FaceGeometry face_geometry(const Vertices& V, const Faces& F, Index f, NormalWeighting weighting) {
-  const Eigen::Vector3d p[3] = {position(V, F(f, 0)), position(V, F(f, 1)), position(V, F(f, 2))};
-  const Eigen::Vector3d d[3] = {p[1] - p[0], p[2] - p[1], p[0] - p[2]};
-  FaceGeometry g;
-  g.normal = d[0].cross(-d[2]);
-  g.normal_weight.setZero();
-  g.corner_area.setZero();
-  const double length = g.normal.norm();
+FaceGeometry face_geometry(Vec3 p0, Vec3 p1, Vec3 p2, NormalWeighting weighting) {
+  // Edge k is opposite corner k; at corner k the two edges are -edge[k + 2] and edge[k + 1].
+  const Vec3 edge[3] = {p2 - p1, p0 - p2, p1 - p0};
+  FaceGeometry g{cross(edge[2], -edge[1]), {0, 0, 0}, {0, 0, 0}};
+  const double length = std::sqrt(squared_norm(g.normal));
   if (!(length > 0)) return g;
-  const double squared[3] = {d[0].squaredNorm(), d[1].squaredNorm(), d[2].squaredNorm()};
-  double dot[3];  // of the two edges at each corner; negative = obtuse
-  for (int k = 0; k < 3; ++k) dot[k] = -d[k].dot(d[(k + 2) % 3]);
+  const double squared[3] = {squared_norm(edge[0]), squared_norm(edge[1]), squared_norm(edge[2])};
+  const double dots[3] = {-dot(edge[2], edge[1]), -dot(edge[0], edge[2]), -dot(edge[1], edge[0])};  // < 0: obtuse
 
   switch (weighting) {
     case NormalWeighting::Max1999: {
-      // 1 / (|d_k|^2 |d_{k+2}|^2) = |d_{k+1}|^2 / (product of all three).
+      // 1 / (|edge k+1|^2 |edge k+2|^2) = |edge k|^2 / (product of all three).
       const double inverse = 1.0 / (squared[0] * squared[1] * squared[2]);
-      for (int k = 0; k < 3; ++k) g.normal_weight[k] = squared[(k + 1) % 3] * inverse;
+      for (int k = 0; k < 3; ++k) g.weight[k] = squared[k] * inverse;
       break;
     }
     case NormalWeighting::Area:
-      g.normal_weight.setOnes();
+      for (double& w : g.weight) w = 1;
       break;
     case NormalWeighting::Angle:
-      for (int k = 0; k < 3; ++k) g.normal_weight[k] = std::atan2(length, dot[k]) / length;
+      for (int k = 0; k < 3; ++k) g.weight[k] = std::atan2(length, dots[k]) / length;
       break;
   }
 
-  const double area = 0.5 * length;
+  const double face_area = 0.5 * length;
   for (int k = 0; k < 3; ++k) {
-    if (dot[k] < 0) {  // obtuse at k: half to k, a quarter to each other corner
-      g.corner_area.setConstant(0.25 * area);
-      g.corner_area[k] = 0.5 * area;
+    if (dots[k] < 0) {  // obtuse at k: half to k, a quarter to each other corner
+      g.area[k] = 0.5 * face_area;
+      g.area[(k + 1) % 3] = g.area[(k + 2) % 3] = 0.25 * face_area;
       return g;
     }
   }
-  // Voronoi region of corner k: (|p_k p_j|^2 cot(angle at l) + |p_k p_l|^2 cot(angle at j)) / 8
-  // with j = k + 1, l = k + 2 and cot(angle at m) = dot[m] / (2 area).
-  const double inverse = 1.0 / (16.0 * area);
-  for (int k = 0; k < 3; ++k) {
-    const int j = (k + 1) % 3, l = (k + 2) % 3;
-    g.corner_area[k] = (squared[k] * dot[l] + squared[l] * dot[j]) * inverse;
-  }
+  // Voronoi region of corner k: (|edge k+2|^2 cot(angle at k+2) + |edge k+1|^2 cot(angle at
+  // k+1)) / 8, with cot(angle at m) = dots[m] / length.
+  const double inverse = 1.0 / (8.0 * length);
+  for (int k = 0; k < 3; ++k)
+    g.area[k] = (squared[(k + 2) % 3] * dots[(k + 2) % 3] + squared[(k + 1) % 3] * dots[(k + 1) % 3]) * inverse;
   return g;
 }
 
-// The second fundamental form of one face, [[e, f], [f, g]] in the face's frame (t, n x t),
-// with n the unit face normal. A zero normal marks a degenerate face.
-struct FaceTensor {
-  Eigen::Vector3d t = Eigen::Vector3d::Zero();
-  Eigen::Vector3d n = Eigen::Vector3d::Zero();
-  double e = 0, f = 0, g = 0;
-};
+FaceGeometry face_geometry(const Vertices& V, const Faces& F, Index f, NormalWeighting weighting) {
+  const Index* face = face_row(F, f);
+  return face_geometry(row(V, face[0]), row(V, face[1]), row(V, face[2]), weighting);
+}
 
-// Least-squares fit (Rusinkiewicz 2004, section 3): for each edge E (from corner j to corner
-// l), II * (E.t, E.b) = ((N_l - N_j).t, (N_l - N_j).b). Six equations, three unknowns.
-FaceTensor fit_face_tensor(const Vertices& V, const Faces& F, const Vertices& N, Index face) {
-  FaceTensor ft;
-  const Eigen::Vector3d p[3] = {position(V, F(face, 0)), position(V, F(face, 1)), position(V, F(face, 2))};
-  const Eigen::Vector3d normal = (p[1] - p[0]).cross(p[2] - p[0]);
-  const double edge = (p[2] - p[1]).norm();
-  if (!(normal.norm() > 0) || !(edge > 0)) return ft;
-  // Reciprocals: one division instead of three per normalised vector (this is the hot loop).
-  ft.t = (p[2] - p[1]) * (1.0 / edge);
-  const Eigen::Vector3d unit_normal = normal * (1.0 / normal.norm());
-  const Eigen::Vector3d b = unit_normal.cross(ft.t);
-  // Normal equations of the rows (u, v, 0) . (e, f, g) = dN.t and (0, u, v) . (e, f, g) = dN.b,
-  // accumulated directly rather than through a 6 x 3 matrix.
-  double uu = 0, uv = 0, vv = 0;
-  Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+// A vertex's tangent frame (u, w, N) with w = N x u, chosen from N alone so that every pass
+// derives the same frame without storing it. The hot passes use u and w unnormalised: both have
+// squared length r2 = 1 - (the dropped component of N)^2 >= 1/2, tensors expressed in them are
+// r2 times the true ones, and the vertex divides once by r2 (instead of a square root and a
+// division per corner).
+struct Frame {
+  Vec3 u, w;
+  double r2;
+};
+inline Frame unnormalised_frame(Vec3 n) {
+  // u is N x e_z or N x e_x, whichever axis is further from N.
+  const Vec3 u = n.z * n.z <= 0.5 ? Vec3{n.y, -n.x, 0} : Vec3{0, n.z, -n.y};
+  return {u, cross(n, u), squared_norm(u)};
+}
+inline Frame unit_frame(Vec3 n) {
+  const Frame f = unnormalised_frame(n);
+  const double inverse = 1.0 / std::sqrt(f.r2);
+  return {inverse * f.u, inverse * f.w, 1.0};
+}
+
+// The symmetric tensor (ku, kuv, kv) in a frame (u, w) rotated by phi from the frame (t, b) of
+// II = [[e, f], [f, g]], with c = cos(phi) = u . t and s = sin(phi) = w . t: u = c t - s b and
+// w = s t + c b, so the result is R^T II R with R = [[c, s], [-s, c]]. (c, s) scaled by r scales
+// the result by r^2.
+struct Tensor {
+  double ku, kuv, kv;
+};
+inline Tensor rotate_tensor(double e, double f, double g, double c, double s) {
+  const double cc = c * c, ss = s * s, cs = c * s;
+  return {e * cc - 2 * f * cs + g * ss, (e - g) * cs + f * (cc - ss), e * ss + 2 * f * cs + g * cc};
+}
+
+// The tensor (e, f, g) given in the frame (t, N' x t) of the tangent plane of unit normal N',
+// expressed in the frame (u, w) of the tangent plane of unit normal N: t is first carried into
+// N's plane by the smallest rotation taking N' to N (Rusinkiewicz 2004, section 4). For t
+// orthogonal to N', Rodrigues' formula reduces that rotation to
+// t' = t - (N . t) / (1 + N' . N) (N' + N): one dot product instead of three cross products.
+inline Tensor transport_tensor(double e, double f, double g, Vec3 t, Vec3 from_normal, Vec3 n, const Frame& frame) {
+  const Vec3 moved = t - (dot(n, t) / (1.0 + dot(from_normal, n))) * (from_normal + n);
+  return rotate_tensor(e, f, g, dot(frame.u, moved), dot(frame.w, moved));
+}
+
+// Faces whose normal is within this of the opposite of the vertex normal are folded over; their
+// frame cannot be rotated meaningfully and they are left out of that vertex's average.
+constexpr double kFoldedCosine = -1.0 + 1e-9;
+
+// The scratch record of one face, reused by both per-face passes: pass 1 writes the face's
+// FaceGeometry (read by the vertices' normal and area gather and by pass 2), then pass 2
+// overwrites it with each corner's area-weighted tensor in (r2 times) its vertex's frame.
+union FaceRecord {
+  FaceGeometry geometry;
+  Tensor corner[3];
+};
+static_assert(sizeof(FaceGeometry) == sizeof(Tensor[3]));
+
+// Pass 2 for one face: least-squares fit of the second fundamental form (Rusinkiewicz 2004,
+// section 3: for each edge E from corner j to corner l, II (E.t, E.b) = ((N_l - N_j).t,
+// (N_l - N_j).b), six equations in e, f, g), then its transport to each corner's vertex frame.
+// Returns a bit per corner left out of its vertex's average (degenerate, failed or folded).
+std::uint8_t fit_and_transport(const Vertices& V, const Faces& F, const Vertices& N, Index face, FaceRecord& record) {
+  const double area[3] = {record.geometry.area[0], record.geometry.area[1], record.geometry.area[2]};
+  record.corner[0] = record.corner[1] = record.corner[2] = Tensor{0, 0, 0};  // now the active member
+  const Index* corner = face_row(F, face);
+  const Vec3 p[3] = {row(V, corner[0]), row(V, corner[1]), row(V, corner[2])};
+  const Vec3 n[3] = {row(N, corner[0]), row(N, corner[1]), row(N, corner[2])};
+  // Edge k is opposite corner k: from corner k + 1 to corner k + 2.
+  const Vec3 edge0 = p[2] - p[1], edge1 = p[0] - p[2];
+  const Vec3 normal = cross(edge0, edge1);  // = (p1 - p0) x (p2 - p0)
+  const double normal_length = std::sqrt(squared_norm(normal));
+  const double edge_length = std::sqrt(squared_norm(edge0));
+  const std::uint8_t all_left_out = (area[0] > 0 ? 1 : 0) | (area[1] > 0 ? 2 : 0) | (area[2] > 0 ? 4 : 0);
+  if (!(normal_length > 0) || !(edge_length > 0)) return all_left_out;
+  // Reciprocals: one division per normalised vector.
+  const Vec3 t = (1.0 / edge_length) * edge0;
+  const Vec3 face_normal = (1.0 / normal_length) * normal;
+  const Vec3 b = cross(face_normal, t);
+
+  // Edge and normal-difference coordinates (u, v) and (dnu, dnv) in the frame (t, b). Edge 0 is
+  // t's own edge, and edges and normal differences both sum to zero around the face, so two
+  // edges give all three.
+  const Vec3 dn0 = n[2] - n[1], dn1 = n[0] - n[2];
+  const double u[3] = {edge_length, dot(edge1, t), -edge_length - dot(edge1, t)};
+  const double v[3] = {0, dot(edge1, b), -dot(edge1, b)};
+  const double dnu0 = dot(dn0, t), dnu1 = dot(dn1, t), dnv0 = dot(dn0, b), dnv1 = dot(dn1, b);
+  const double dnu[3] = {dnu0, dnu1, -dnu0 - dnu1}, dnv[3] = {dnv0, dnv1, -dnv0 - dnv1};
+  // Normal equations of the rows (u, v, 0) . (e, f, g) = dnu and (0, u, v) . (e, f, g) = dnv.
+  double uu = 0, uv = 0, vv = 0, r0 = 0, r1 = 0, r2 = 0;
   for (int k = 0; k < 3; ++k) {
-    const int j = (k + 1) % 3, l = (k + 2) % 3;
-    const Eigen::Vector3d E = p[l] - p[j];
-    const Eigen::Vector3d dN = N.row(F(face, l)).transpose() - N.row(F(face, j)).transpose();
-    const double u = E.dot(ft.t), v = E.dot(b);
-    const double dnu = dN.dot(ft.t), dnv = dN.dot(b);
-    uu += u * u;
-    uv += u * v;
-    vv += v * v;
-    rhs += Eigen::Vector3d(u * dnu, v * dnu + u * dnv, v * dnv);
+    uu += u[k] * u[k];
+    uv += u[k] * v[k];
+    vv += v[k] * v[k];
+    r0 += u[k] * dnu[k];
+    r1 += v[k] * dnu[k] + u[k] * dnv[k];
+    r2 += v[k] * dnv[k];
   }
   Eigen::Matrix3d normal_matrix;
   normal_matrix << uu, uv, 0, uv, uu + vv, uv, 0, uv, vv;
+  const Eigen::Vector3d rhs(r0, r1, r2);
   // A robust small solve from Eigen, not the widely copied hand-written 3x3 LDLT (which reads
   // entries before writing them and biases curvatures low). The matrix is symmetric positive
   // definite for any non-degenerate triangle, so Cholesky applies; pivoted LDLT takes over if
@@ -133,68 +223,44 @@ FaceTensor fit_face_tensor(const Vertices& V, const Faces& F, const Vertices& N,
   } else {
     solution = normal_matrix.ldlt().solve(rhs);
   }
-  if (!solution.allFinite()) return ft;
-  ft.e = solution[0];
-  ft.f = solution[1];
-  ft.g = solution[2];
-  ft.n = unit_normal;
-  return ft;
+  if (!solution.allFinite()) return all_left_out;
+  const double e = solution[0], f = solution[1], g = solution[2];
+
+  std::uint8_t left_out = 0;
+  for (int k = 0; k < 3; ++k) {
+    if (!(area[k] > 0)) continue;
+    if (dot(face_normal, n[k]) <= kFoldedCosine) {
+      left_out |= static_cast<std::uint8_t>(1 << k);
+      continue;
+    }
+    const Tensor tensor = transport_tensor(e, f, g, t, face_normal, n[k], unnormalised_frame(n[k]));
+    record.corner[k] = {area[k] * tensor.ku, area[k] * tensor.kuv, area[k] * tensor.kv};
+  }
+  return left_out;
 }
 
-// The first axis of a vertex's tangent frame (u, N x u, N): any unit vector orthogonal to N,
-// chosen from N alone so every pass derives the same frame without storing it.
-Eigen::Vector3d vertex_frame(const Eigen::Vector3d& n) {
-  return n.unitOrthogonal();
-}
-
-// Rotates a vector x tangent to unit `from` (x . from = 0) by the smallest rotation taking
-// `from` to unit `to`. Rodrigues' R x = x + w x x + w x (w x x) / (1 + c), with w = from x to and
-// c = from . to, reduces for such x to x - (to . x) (from + to) / (1 + c): one dot product
-// instead of three cross products (this runs once per corner).
-inline Eigen::Vector3d rotate_tangent(const Eigen::Vector3d& x, const Eigen::Vector3d& from,
-                                      const Eigen::Vector3d& to) {
-  return x - (to.dot(x) / (1.0 + from.dot(to))) * (from + to);
-}
-
-// The symmetric tensor (ku, kuv, kv) in the vertex frame (u, w = N x u) of a tensor
-// [[e, f], [f, g]] given in the frame (t, N x t) of the same tangent plane. With
-// cos(phi) = u.t and sin(phi) = w.t, the frame change is a plane rotation by phi.
-inline Eigen::Vector3d tensor_in_frame(double e, double f, double g, const Eigen::Vector3d& t, const Eigen::Vector3d& u,
-                                       const Eigen::Vector3d& w) {
-  const double c = u.dot(t), s = w.dot(t);
-  // u = c t - s b and w = s t + c b, where b = N x t.
-  const double u1 = c, v1 = -s, u2 = s, v2 = c;
-  return {e * u1 * u1 + 2 * f * u1 * v1 + g * v1 * v1, e * u1 * u2 + f * (u1 * v2 + u2 * v1) + g * v1 * v2,
-          e * u2 * u2 + 2 * f * u2 * v2 + g * v2 * v2};
-}
-
-// Faces whose normal is within this of the opposite of the vertex normal are folded over; their
-// frame cannot be rotated meaningfully and they are left out of that vertex's average.
-constexpr double kFoldedCosine = -1.0 + 1e-9;
-
-// Diagonalises the vertex tensor into k1 >= k2 and T1, T2 (T1 x T2 = N).
-void diagonalize(const Eigen::Vector3d& tensor, const Eigen::Vector3d& u, const Eigen::Vector3d& v,
-                 const Eigen::Vector3d& n, double& k1, double& k2, Eigen::Vector3d& t1, Eigen::Vector3d& t2) {
-  const double ku = tensor[0], kuv = tensor[1], kv = tensor[2];
-  const double mean = 0.5 * (ku + kv);
-  const double half_difference = 0.5 * (ku - kv);
+// Diagonalises the vertex tensor (ku, kuv, kv), given in the unit frame, into k1 >= k2 and
+// T1, T2 (T1 x T2 = N).
+void diagonalize(const Tensor& tensor, const Frame& frame, Vec3 n, double& k1, double& k2, Vec3& t1, Vec3& t2) {
+  const double mean = 0.5 * (tensor.ku + tensor.kv);
+  const double half_difference = 0.5 * (tensor.ku - tensor.kv);
   // Plain square roots: the operands are curvatures of a mesh whose size read_mesh bounds, far
   // from overflow, and std::hypot's care costs more than the rest of this function.
-  const double radius = std::sqrt(half_difference * half_difference + kuv * kuv);
+  const double radius = std::sqrt(half_difference * half_difference + tensor.kuv * tensor.kuv);
   k1 = mean + radius;
   k2 = mean - radius;
-  // Eigenvector of k1 in (u, v) coordinates: (radius + half_difference, kuv), or the
+  // Eigenvector of k1 in (u, w) coordinates: (radius + half_difference, kuv), or the
   // equivalent (kuv, radius - half_difference) when that is better conditioned.
-  double x = radius + half_difference, y = kuv;
-  if (half_difference < 0) x = kuv, y = radius - half_difference;
+  double x = radius + half_difference, y = tensor.kuv;
+  if (half_difference < 0) x = tensor.kuv, y = radius - half_difference;
   const double length = std::sqrt(x * x + y * y);
   if (length > 0) {
     const double inverse = 1.0 / length;
-    t1 = (x * inverse) * u + (y * inverse) * v;
+    t1 = (x * inverse) * frame.u + (y * inverse) * frame.w;
   } else {  // umbilic: any direction
-    t1 = u;
+    t1 = frame.u;
   }
-  t2 = n.cross(t1);
+  t2 = cross(n, t1);
 }
 
 }  // namespace
@@ -203,7 +269,7 @@ Vertices vertex_normals(const Vertices& V, const Faces& F, NormalWeighting weigh
   Vertices N = Vertices::Zero(V.rows(), 3);
   for (Index f = 0; f < F.rows(); ++f) {
     const FaceGeometry g = face_geometry(V, F, f, weighting);
-    for (int k = 0; k < 3; ++k) N.row(F(f, k)) += g.normal_weight[k] * g.normal.transpose();
+    for (int k = 0; k < 3; ++k) set_row(N, F(f, k), row(N, F(f, k)) + g.weight[k] * g.normal);
   }
   for (Index v = 0; v < V.rows(); ++v) {
     const double length = N.row(v).norm();
@@ -215,7 +281,8 @@ Vertices vertex_normals(const Vertices& V, const Faces& F, NormalWeighting weigh
 CornerAreas corner_areas(const Vertices& V, const Faces& F) {
   CornerAreas areas(F.rows(), 3);
   parallel_range(static_cast<Index>(F.rows()), [&](Index f) {
-    areas.row(f) = face_geometry(V, F, f, NormalWeighting::Area).corner_area.transpose();
+    const FaceGeometry g = face_geometry(V, F, f, NormalWeighting::Area);
+    for (int k = 0; k < 3; ++k) areas(f, k) = g.area[k];
   });
   return areas;
 }
@@ -241,115 +308,108 @@ Curvature principal_curvatures(const Vertices& V, const Faces& F, const Topology
     throw std::invalid_argument("principal_curvatures: the topology was built for another mesh");
   if (!topology.is_manifold()) throw std::invalid_argument(describe_non_manifold(topology));
   Curvature c;
-  c.k1 = Eigen::VectorXd::Zero(nv);
-  c.k2 = Eigen::VectorXd::Zero(nv);
+  c.k1.resize(nv);
+  c.k2.resize(nv);
   c.T1.resize(nv, 3);
   c.T2.resize(nv, 3);
   c.N.resize(nv, 3);
-  c.area = Eigen::VectorXd::Zero(nv);
+  c.area.resize(nv);
+  for (Eigen::VectorXd* v : {&c.k1, &c.k2, &c.area}) advise_huge_pages(*v);
+  for (Vertices* m : {&c.T1, &c.T2, &c.N}) advise_huge_pages(*m);
 
-  auto corner_of = [&](Index f, Index v) { return F(f, 0) == v ? 0 : F(f, 1) == v ? 1 : 2; };
-  // The record slots of v's corners, in the topology's fixed face order (determinism).
-  auto sum_corner_records = [&](Index v, const std::vector<Eigen::Vector4d>& records) {
-    Eigen::Vector4d sum = Eigen::Vector4d::Zero();
-    const auto first = topology.face_offsets[static_cast<std::size_t>(v)];
-    const auto last = topology.face_offsets[static_cast<std::size_t>(v) + 1];
-    for (Index i = first; i < last; ++i) {
-      const Index f = topology.vertex_faces[static_cast<std::size_t>(i)];
-      sum += records[3 * static_cast<std::size_t>(f) + static_cast<std::size_t>(corner_of(f, v))];
-    }
-    return sum;
+  // One record per face (FaceRecord), uninitialised on purpose: pass 1 writes every one.
+  const std::unique_ptr<FaceRecord[]> records(new FaceRecord[static_cast<std::size_t>(nf)]);
+  advise_huge_pages(records.get(), static_cast<std::size_t>(nf) * sizeof(FaceRecord));
+  const std::unique_ptr<std::uint8_t[]> left_out(new std::uint8_t[static_cast<std::size_t>(nf)]);
+  auto record = [&](Index f) -> FaceRecord& { return records[static_cast<std::size_t>(f)]; };
+  auto incident_faces = [&](Index v) {
+    const auto first = static_cast<std::size_t>(topology.face_offsets[static_cast<std::size_t>(v)]);
+    const auto last = static_cast<std::size_t>(topology.face_offsets[static_cast<std::size_t>(v) + 1]);
+    return std::pair(topology.vertex_faces.data() + first, topology.vertex_faces.data() + last);
   };
 
-  // One record per corner, reused by both gathers: first (weighted face normal, mixed area),
-  // then (area-weighted tensor in the vertex frame, area). Each face's geometry is computed
-  // once and each vertex sums its corners, which is cheaper than recomputing per corner and
-  // keeps the order of additions fixed.
-  std::vector<Eigen::Vector4d> corner_record(3 * static_cast<std::size_t>(nf));
-  auto record = [&](Index f, int k) -> Eigen::Vector4d& {
-    return corner_record[3 * static_cast<std::size_t>(f) + static_cast<std::size_t>(k)];
-  };
+  // Pass 1, per face: normal weights and mixed areas of the corners.
+  parallel_range(nf, [&](Index f) { record(f).geometry = face_geometry(V, F, f, options.normal_weighting); });
 
-  // Pass 1, per face: each corner's contribution to its vertex normal and mixed area.
-  parallel_range(nf, [&](Index f) {
-    const FaceGeometry g = face_geometry(V, F, f, options.normal_weighting);
-    for (int k = 0; k < 3; ++k) record(f, k) << g.normal_weight[k] * g.normal, g.corner_area[k];
-  });
-
-  // Pass 2, per vertex: unit normal, mixed area and the first axis of the tangent frame.
-  Vertices frame_u(nv, 3);
+  // Pass 1b, per vertex: unit normal and mixed area, summed over the incident faces in the
+  // topology's fixed order.
   parallel_range(nv, [&](Index v) {
-    const Eigen::Vector4d sum = sum_corner_records(v, corner_record);
-    const double length = sum.head<3>().norm();
-    const Eigen::Vector3d n = length > 0 ? Eigen::Vector3d(sum.head<3>() * (1.0 / length)) : Eigen::Vector3d(0, 0, 1);
-    c.N.row(v) = n.transpose();
-    frame_u.row(v) = vertex_frame(n).transpose();
-    c.area[v] = sum[3];
-  });
-
-  // Pass 3, per face: fit the second fundamental form (Rusinkiewicz 2004, section 3) and
-  // rotate it into the tangent frame of each of its three vertices (section 4).
-  parallel_range(nf, [&](Index f) {
-    const FaceTensor ft = fit_face_tensor(V, F, c.N, f);
-    for (int k = 0; k < 3; ++k) {
-      Eigen::Vector4d& slot = record(f, k);
-      const double corner_area = slot[3];
-      const Index v = F(f, k);
-      const Eigen::Vector3d n = c.N.row(v).transpose();
-      // Skip degenerate faces (zero area or failed fit: zero normal) and folded-over ones.
-      if (!(corner_area > 0) || ft.n.squaredNorm() == 0 || ft.n.dot(n) <= kFoldedCosine) {
-        slot.setZero();
-        continue;
-      }
-      const Eigen::Vector3d u = frame_u.row(v).transpose();
-      const Eigen::Vector3d t = rotate_tangent(ft.t, ft.n, n);
-      slot << corner_area * tensor_in_frame(ft.e, ft.f, ft.g, t, u, n.cross(u)), corner_area;
+    Vec3 normal{0, 0, 0};
+    double area = 0;
+    const auto [begin, end] = incident_faces(v);
+    for (const Index* f = begin; f != end; ++f) {
+      const FaceGeometry& g = record(*f).geometry;
+      const int k = corner_of(F, *f, v);
+      normal = normal + g.weight[k] * g.normal;
+      area += g.area[k];
     }
+    const double length = std::sqrt(squared_norm(normal));
+    set_row(c.N, v, length > 0 ? (1.0 / length) * normal : Vec3{0, 0, 1});
+    c.area[v] = area;
   });
 
-  // Pass 4, per vertex: the area-weighted mean of its corners' tensors, then (unless the
-  // tensors are smoothed first) principal curvatures and directions.
-  Vertices tensor = Vertices::Zero(nv, 3);
-  auto diagonalize_vertex = [&](Index v) {
-    const Eigen::Vector3d n = c.N.row(v).transpose(), u = frame_u.row(v).transpose(), w = n.cross(u);
-    double k1 = 0, k2 = 0;
-    Eigen::Vector3d t1, t2;
-    diagonalize(tensor.row(v).transpose(), u, w, n, k1, k2, t1, t2);
-    c.k1[v] = k1;
-    c.k2[v] = k2;
-    c.T1.row(v) = t1.transpose();
-    c.T2.row(v) = t2.transpose();
+  // Pass 2, per face: fit and transport (fit_and_transport).
+  parallel_range(nf, [&](Index f) { left_out[static_cast<std::size_t>(f)] = fit_and_transport(V, F, c.N, f, record(f)); });
+
+  // Pass 3, per vertex: the area-weighted mean of its corners' tensors (Rusinkiewicz 2004,
+  // section 4), then (unless the tensors are smoothed first) principal curvatures and
+  // directions. Corners left out by pass 2 (rare) have their area taken off the weight.
+  auto vertex_tensor = [&](Index v) {
+    double ku = 0, kuv = 0, kv = 0, weight = c.area[v];
+    const auto [begin, end] = incident_faces(v);
+    for (const Index* f = begin; f != end; ++f) {
+      const int k = corner_of(F, *f, v);
+      const Tensor& t = record(*f).corner[k];
+      ku += t.ku;
+      kuv += t.kuv;
+      kv += t.kv;
+      if (left_out[static_cast<std::size_t>(*f)] & (1 << k))
+        weight -= face_geometry(V, F, *f, options.normal_weighting).area[k];
+    }
+    if (!(weight > 0)) return Tensor{0, 0, 0};
+    const double inverse = 1.0 / (weight * unnormalised_frame(row(c.N, v)).r2);
+    return Tensor{ku * inverse, kuv * inverse, kv * inverse};
   };
-  const bool smooth = options.smoothing_rounds > 0;
-  parallel_range(nv, [&](Index v) {
-    const Eigen::Vector4d sum = sum_corner_records(v, corner_record);
-    if (sum[3] > 0) tensor.row(v) = sum.head<3>().transpose() * (1.0 / sum[3]);
-    if (!smooth) diagonalize_vertex(v);
-  });
-  corner_record = std::vector<Eigen::Vector4d>();
-  if (!smooth) return c;
+  auto diagonalize_vertex = [&](Index v, const Tensor& tensor) {
+    const Vec3 n = row(c.N, v);
+    Vec3 t1, t2;
+    diagonalize(tensor, unit_frame(n), n, c.k1[v], c.k2[v], t1, t2);
+    set_row(c.T1, v, t1);
+    set_row(c.T2, v, t2);
+  };
+  if (options.smoothing_rounds <= 0) {
+    parallel_range(nv, [&](Index v) { diagonalize_vertex(v, vertex_tensor(v)); });
+    return c;
+  }
 
   // Optional smoothing: average each tensor with its neighbours', transported likewise.
+  std::vector<Tensor> tensor(static_cast<std::size_t>(nv));
+  parallel_range(nv, [&](Index v) { tensor[static_cast<std::size_t>(v)] = vertex_tensor(v); });
   for (int round = 0; round < options.smoothing_rounds; ++round) {
-    Vertices smoothed(nv, 3);
+    std::vector<Tensor> smoothed(static_cast<std::size_t>(nv));
     parallel_range(nv, [&](Index v) {
-      const Eigen::Vector3d n = c.N.row(v).transpose(), u = frame_u.row(v).transpose(), w = n.cross(u);
-      Eigen::Vector3d sum = c.area[v] * tensor.row(v).transpose();
+      const Vec3 n = row(c.N, v);
+      const Frame frame = unit_frame(n);
+      const Tensor& own = tensor[static_cast<std::size_t>(v)];
       double weight = c.area[v];
+      Tensor sum{weight * own.ku, weight * own.kuv, weight * own.kv};
       const auto [begin, end] = topology.ring(v);
       for (const Index* j = begin; j != end; ++j) {
-        const Eigen::Vector3d nj = c.N.row(*j).transpose();
-        if (nj.dot(n) <= kFoldedCosine) continue;
-        const Eigen::Vector3d uj = rotate_tangent(frame_u.row(*j).transpose(), nj, n);
-        const Eigen::Vector3d tj = tensor.row(*j).transpose();
-        sum += c.area[*j] * tensor_in_frame(tj[0], tj[1], tj[2], uj, u, w);
-        weight += c.area[*j];
+        const Vec3 nj = row(c.N, *j);
+        if (dot(nj, n) <= kFoldedCosine) continue;
+        // The neighbour's tensor is given in its frame (uj, nj x uj).
+        const Tensor& tj = tensor[static_cast<std::size_t>(*j)];
+        const Tensor moved = transport_tensor(tj.ku, tj.kuv, tj.kv, unit_frame(nj).u, nj, n, frame);
+        const double aj = c.area[*j];
+        sum = {sum.ku + aj * moved.ku, sum.kuv + aj * moved.kuv, sum.kv + aj * moved.kv};
+        weight += aj;
       }
-      smoothed.row(v) = weight > 0 ? Eigen::RowVector3d(sum.transpose() / weight) : Eigen::RowVector3d(tensor.row(v));
+      smoothed[static_cast<std::size_t>(v)] =
+          weight > 0 ? Tensor{sum.ku / weight, sum.kuv / weight, sum.kv / weight} : own;
     });
     tensor = std::move(smoothed);
   }
-  parallel_range(nv, diagonalize_vertex);
+  parallel_range(nv, [&](Index v) { diagonalize_vertex(v, tensor[static_cast<std::size_t>(v)]); });
   return c;
 }
 
