@@ -18,7 +18,8 @@ void advise_huge_pages(void* data, std::size_t bytes);
 /// The same for an Eigen matrix or vector (any type with data() and size()).
 template <class Dense>
 void advise_huge_pages(Dense& matrix) {
-  advise_huge_pages(static_cast<void*>(matrix.data()), static_cast<std::size_t>(matrix.size()) * sizeof(*matrix.data()));
+  advise_huge_pages(static_cast<void*>(matrix.data()),
+                    static_cast<std::size_t>(matrix.size()) * sizeof(*matrix.data()));
 }
 
 }  // namespace vertexflow

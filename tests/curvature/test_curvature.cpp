@@ -11,6 +11,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
+#include <random>
 #include <vector>
 
 namespace vertexflow {
@@ -205,6 +207,42 @@ TEST(Curvature, SameResultForOneAndTwoThreads) {
   EXPECT_EQ(one.k2, two.k2);
   EXPECT_EQ(one.T1, two.T1);
   EXPECT_EQ(one.N, two.N);
+}
+
+// Vertex and face order, and which corner a face lists first, change only the order of
+// floating-point additions (and which SIMD lane and block computes a face), not the result.
+TEST(Curvature, IndependentOfVertexAndFaceOrder) {
+  const Mesh mesh = read_mesh(test::data_path("armadillo-43k.obj"));
+  std::mt19937 rng(7);
+  std::vector<Index> new_index(static_cast<std::size_t>(mesh.num_vertices()));
+  std::iota(new_index.begin(), new_index.end(), 0);
+  std::shuffle(new_index.begin(), new_index.end(), rng);
+  std::vector<Index> face_order(static_cast<std::size_t>(mesh.num_faces()));
+  std::iota(face_order.begin(), face_order.end(), 0);
+  std::shuffle(face_order.begin(), face_order.end(), rng);
+  Mesh shuffled;
+  shuffled.V.resize(mesh.num_vertices(), 3);
+  for (Index v = 0; v < mesh.num_vertices(); ++v)
+    shuffled.V.row(new_index[static_cast<std::size_t>(v)]) = mesh.V.row(v);
+  shuffled.F.resize(mesh.num_faces(), 3);
+  for (Index f = 0; f < mesh.num_faces(); ++f) {
+    const Index source = face_order[static_cast<std::size_t>(f)];
+    for (int k = 0; k < 3; ++k)  // rotate the corners by f % 3 (same orientation)
+      shuffled.F(f, k) = new_index[static_cast<std::size_t>(mesh.F(source, (k + f) % 3))];
+  }
+  const Curvature c = principal_curvatures(mesh.V, mesh.F);
+  const Curvature s = principal_curvatures(shuffled.V, shuffled.F);
+  const double scale = c.k1.cwiseAbs().maxCoeff();
+  for (Index v = 0; v < mesh.num_vertices(); ++v) {
+    const Index w = new_index[static_cast<std::size_t>(v)];
+    ASSERT_NEAR(s.k1[w], c.k1[v], 1e-9 * scale) << v;
+    ASSERT_NEAR(s.k2[w], c.k2[v], 1e-9 * scale) << v;
+    ASSERT_NEAR(s.area[w], c.area[v], 1e-12 * c.area.maxCoeff()) << v;
+    ASSERT_LE((s.N.row(w) - c.N.row(v)).norm(), 1e-12) << v;
+    if (c.k1[v] - c.k2[v] > 1e-3 * scale) {
+      ASSERT_LE(line_angle_degrees(s.T1.row(w).transpose(), c.T1.row(v).transpose()), 1e-5) << v;
+    }
+  }
 }
 
 TEST(Curvature, HemisphereBoundaryIsFiniteAndItsBiasIsBounded) {
