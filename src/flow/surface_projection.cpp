@@ -47,8 +47,8 @@ Candidate closest_on_face(const Eigen::Vector3d& x, const Vertices& V, const Fac
 // q blended with its projections onto the tangent planes of the face's corners. It lifts a
 // point of a flat facet onto a smooth surface through the vertices with their normals, so that
 // vertices sliding over a curved region do not sink into the chords (spot lost 0.5% of its
-// volume on the flat facets). Corners on sharp features contribute q itself: no bulge across a
-// crease.
+// volume on the flat facets). Corners on sharp edges (SurfaceFeatures::on_sharp_edge)
+// contribute q itself: no bulge across a crease.
 Eigen::Vector3d phong_point(const Eigen::Vector3d& q, const Vertices& V, const Faces& F, Index f,
                             const Vertices& normals, const SurfaceFeatures& features) {
   const Eigen::Vector3d p[3] = {V.row(F(f, 0)), V.row(F(f, 1)), V.row(F(f, 2))};
@@ -62,8 +62,7 @@ Eigen::Vector3d phong_point(const Eigen::Vector3d& q, const Vertices& V, const F
     const Eigen::Vector3d nk = normals.row(F(f, k)).transpose();
     direction += weight * nk;
     Eigen::Vector3d on_plane = q;
-    if (features.vertex_kind[static_cast<std::size_t>(F(f, k))] == SurfaceFeatures::Kind::Smooth)
-      on_plane -= (q - p[k]).dot(nk) * nk;
+    if (!features.on_sharp_edge[static_cast<std::size_t>(F(f, k))]) on_plane -= (q - p[k]).dot(nk) * nk;
     lifted += weight * on_plane;
   }
   constexpr double kShape = 0.75;
@@ -128,6 +127,12 @@ SurfaceFeatures detect_features(const Vertices& V, const Faces& F, const Topolog
       }
     }
   }
+  features.on_sharp_edge.assign(static_cast<std::size_t>(topology.num_vertices), 0);
+  for (std::size_t e = 0; e < num_edges; ++e) {
+    if (!features.sharp_edge[e]) continue;
+    for (int end = 0; end < 2; ++end)
+      features.on_sharp_edge[static_cast<std::size_t>(topology.edges(static_cast<Index>(e), end))] = 1;
+  }
   // A crease is a connected set of at least kMinCreaseEdges sharp edges. Shorter ones are the
   // noise of scans (a 40-degree threshold marks about 2% of bunny_uniform's vertices), where
   // holding vertices would only stop the flow.
@@ -150,37 +155,9 @@ SurfaceFeatures detect_features(const Vertices& V, const Faces& F, const Topolog
       if (features.sharp_edge[e]) ++edges_in[static_cast<std::size_t>(root(topology.edges(static_cast<Index>(e), 0)))];
     }
     for (std::size_t e = 0; e < num_edges; ++e) {
-      if (!features.sharp_edge[e]) continue;
-      if (edges_in[static_cast<std::size_t>(root(topology.edges(static_cast<Index>(e), 0)))] < kMinCreaseEdges) {
+      if (features.sharp_edge[e] &&
+          edges_in[static_cast<std::size_t>(root(topology.edges(static_cast<Index>(e), 0)))] < kMinCreaseEdges)
         features.sharp_edge[e] = 0;
-        continue;
-      }
-      for (int end = 0; end < 2; ++end)
-        features.vertex_sharp[static_cast<std::size_t>(topology.edges(static_cast<Index>(e), end))].push_back(
-            static_cast<Index>(e));
-    }
-  }
-  features.vertex_normals = vertex_normals(V, F);
-  features.vertex_kind.resize(static_cast<std::size_t>(topology.num_vertices));
-  for (std::size_t v = 0; v < features.vertex_kind.size(); ++v) {
-    std::sort(features.vertex_sharp[v].begin(), features.vertex_sharp[v].end());  // deterministic walks
-    const std::size_t count = features.vertex_sharp[v].size();
-    features.vertex_kind[v] = count == 0   ? SurfaceFeatures::Kind::Smooth
-                              : count == 2 ? SurfaceFeatures::Kind::Crease
-                                           : SurfaceFeatures::Kind::Corner;
-    // A crease that turns by more than the feature angle at v is a corner too: sliding v along
-    // either edge would cut it off.
-    if (count == 2) {
-      Eigen::Vector3d direction[2];
-      for (int k = 0; k < 2; ++k) {
-        const Index e = features.vertex_sharp[v][static_cast<std::size_t>(k)];
-        const Index other = topology.edges(e, 0) == static_cast<Index>(v) ? topology.edges(e, 1) : topology.edges(e, 0);
-        direction[k] = (V.row(other) - V.row(static_cast<Index>(v))).transpose();
-      }
-      // Straight on: the two edges point in opposite directions (dot = -|a||b|).
-      const double product = direction[0].norm() * direction[1].norm();
-      if (!(product > 0) || -direction[0].dot(direction[1]) < cosine * product)
-        features.vertex_kind[v] = SurfaceFeatures::Kind::Corner;
     }
   }
   // Patches: flood fill across non-sharp interior edges.
@@ -204,6 +181,48 @@ SurfaceFeatures detect_features(const Vertices& V, const Faces& F, const Topolog
       }
     }
     ++patches;
+  }
+  // A crease separates two patches: the features of a CAD part form a network that cuts the
+  // surface into faces. A sharp edge with the same patch on both sides belongs to a chain that
+  // ends inside one patch: on a scan, an under-sampled ridge or noise (bunny_uniform: 268 sharp
+  // edges at 40 degrees, all but 24 of them such chains, whose 1- and 3-edge ends made 132
+  // vertices corners), exactly where the flow should bring vertices, not freeze them. Unmarking
+  // such an edge merges no patches (its sides are already one), so one pass finds them all.
+  for (Index f = 0; f < F.rows(); ++f) {
+    for (int k = 0; k < 3; ++k) {
+      const Index g = topology.face_adjacency(f, k);
+      if (g > f && features.face_patch[static_cast<std::size_t>(f)] == features.face_patch[static_cast<std::size_t>(g)])
+        features.sharp_edge[static_cast<std::size_t>(topology.face_edges(f, k))] = 0;
+    }
+  }
+  for (std::size_t e = 0; e < num_edges; ++e) {
+    if (!features.sharp_edge[e]) continue;
+    for (int end = 0; end < 2; ++end)
+      features.vertex_sharp[static_cast<std::size_t>(topology.edges(static_cast<Index>(e), end))].push_back(
+          static_cast<Index>(e));
+  }
+  features.vertex_normals = vertex_normals(V, F);
+  features.vertex_kind.resize(static_cast<std::size_t>(topology.num_vertices));
+  for (std::size_t v = 0; v < features.vertex_kind.size(); ++v) {
+    std::sort(features.vertex_sharp[v].begin(), features.vertex_sharp[v].end());  // deterministic walks
+    const std::size_t count = features.vertex_sharp[v].size();
+    features.vertex_kind[v] = count == 0   ? SurfaceFeatures::Kind::Smooth
+                              : count == 2 ? SurfaceFeatures::Kind::Crease
+                                           : SurfaceFeatures::Kind::Corner;
+    // A crease that turns by more than the feature angle at v is a corner too: sliding v along
+    // either edge would cut it off.
+    if (count == 2) {
+      Eigen::Vector3d direction[2];
+      for (int k = 0; k < 2; ++k) {
+        const Index e = features.vertex_sharp[v][static_cast<std::size_t>(k)];
+        const Index other = topology.edges(e, 0) == static_cast<Index>(v) ? topology.edges(e, 1) : topology.edges(e, 0);
+        direction[k] = (V.row(other) - V.row(static_cast<Index>(v))).transpose();
+      }
+      // Straight on: the two edges point in opposite directions (dot = -|a||b|).
+      const double product = direction[0].norm() * direction[1].norm();
+      if (!(product > 0) || -direction[0].dot(direction[1]) < cosine * product)
+        features.vertex_kind[v] = SurfaceFeatures::Kind::Corner;
+    }
   }
   return features;
 }

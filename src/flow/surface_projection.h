@@ -10,7 +10,9 @@
 namespace vertexflow {
 
 /// Sharp features of a mesh: an interior edge is sharp when the normals of its two faces differ
-/// by more than the feature angle. Patches are the face sets connected across non-sharp edges.
+/// by more than the feature angle and it separates two patches, the face sets connected across
+/// non-sharp edges (a chain of such edges that ends inside one patch is an under-sampled ridge
+/// or scan noise, not a crease).
 struct SurfaceFeatures {
   enum class Kind : char { Smooth, Crease, Corner };
   std::vector<char> sharp_edge;                  ///< per edge of the topology
@@ -19,6 +21,9 @@ struct SurfaceFeatures {
   /// Crease: exactly two sharp edges that continue each other within the feature angle;
   /// Corner: one, three or more, or two that turn.
   std::vector<Kind> vertex_kind;
+  /// Vertices on an edge sharper than the feature angle, a crease or not: their normal
+  /// averages across the edge, so the Phong lift takes no height from them.
+  std::vector<char> on_sharp_edge;
   Vertices vertex_normals;  ///< of the mesh (curvature.h), for the Phong height of projections
 };
 
