@@ -34,6 +34,28 @@ void parallel_range(Index n, Body&& body) {
   });
 }
 
+// The passes written as loops over blocks of lanes (the *_block functions) get an AVX2 + FMA
+// clone next to the baseline one; the dynamic loader picks one per machine (GCC's
+// target_clones). Blocks start at fixed indices and the tail block is padded, so every element
+// is computed in the same lane whatever the thread partition: results do not depend on the
+// thread count.
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
+#define VERTEXFLOW_SIMD_CLONES __attribute__((target_clones("arch=x86-64-v3", "default")))
+#else
+#define VERTEXFLOW_SIMD_CLONES
+#endif
+constexpr int kBlock = 64;
+
+// Runs body(first, count) over [0, n) in blocks of kBlock, in parallel.
+template <class Body>
+void parallel_blocks(Index n, Body&& body) {
+  const Index blocks = (n + kBlock - 1) / kBlock;
+  tbb::parallel_for(tbb::blocked_range<Index>(0, blocks, 32), [&](const tbb::blocked_range<Index>& r) {
+    for (Index b = r.begin(); b != r.end(); ++b)
+      body(b * kBlock, static_cast<int>(std::min<Index>(kBlock, n - b * kBlock)));
+  });
+}
+
 struct Vec3 {
   double x, y, z;
 };
@@ -180,6 +202,61 @@ union FaceRecord {
 };
 static_assert(sizeof(FaceGeometry) == sizeof(Tensor[3]));
 
+// Pass 1 for the faces [first, first + count), count <= kBlock: face_geometry for the Max1999
+// (max_weighting) or Area weighting, as a branch-free loop over lanes that the compiler
+// vectorises (VERTEXFLOW_SIMD_CLONES). Flags are 0/1 doubles; divisors of degenerate faces are
+// shifted off zero and their results multiplied by 0.
+VERTEXFLOW_SIMD_CLONES
+void face_geometry_block(const Vertices& V, const Faces& F, Index first, int count, bool max_weighting,
+                         FaceRecord* records) {
+  constexpr int L = kBlock;
+  alignas(64) double p[3][3][L], normal[3][L], weight[3][L], area[3][L];
+  for (int i = 0; i < L; ++i) {
+    const Index* face = face_row(F, first + (i < count ? i : count - 1));
+    for (int k = 0; k < 3; ++k) {
+      const double* pk = V.data() + 3 * static_cast<std::ptrdiff_t>(face[k]);
+      for (int d = 0; d < 3; ++d) p[k][d][i] = pk[d];
+    }
+  }
+  const double use_max = max_weighting ? 1.0 : 0.0;
+  for (int i = 0; i < L; ++i) {
+    const Vec3 p0{p[0][0][i], p[0][1][i], p[0][2][i]}, p1{p[1][0][i], p[1][1][i], p[1][2][i]},
+        p2{p[2][0][i], p[2][1][i], p[2][2][i]};
+    const Vec3 edge[3] = {p2 - p1, p0 - p2, p1 - p0};
+    const Vec3 n = cross(edge[2], -edge[1]);
+    const double length = std::sqrt(squared_norm(n));
+    const double valid = static_cast<double>(length > 0), invalid = 1.0 - valid;
+    const double squared[3] = {squared_norm(edge[0]), squared_norm(edge[1]), squared_norm(edge[2])};
+    const double dots[3] = {-dot(edge[2], edge[1]), -dot(edge[0], edge[2]), -dot(edge[1], edge[0])};
+    const double inverse_product = 1.0 / (squared[0] * squared[1] * squared[2] + invalid);
+    // At most one corner is obtuse; if rounding makes two, the first counts (as face_geometry).
+    const double obtuse0 = static_cast<double>(dots[0] < 0);
+    const double obtuse1 = static_cast<double>(dots[1] < 0) * (1.0 - obtuse0);
+    const double obtuse2 = static_cast<double>(dots[2] < 0) * (1.0 - obtuse0) * (1.0 - obtuse1);
+    const double obtuse[3] = {obtuse0, obtuse1, obtuse2};
+    const double any_obtuse = obtuse0 + obtuse1 + obtuse2;
+    const double quarter = 0.125 * length, inverse = 1.0 / (8.0 * length + invalid);
+    normal[0][i] = n.x;
+    normal[1][i] = n.y;
+    normal[2][i] = n.z;
+#pragma GCC unroll 3
+    for (int k = 0; k < 3; ++k) {
+      const double voronoi =
+          (squared[(k + 2) % 3] * dots[(k + 2) % 3] + squared[(k + 1) % 3] * dots[(k + 1) % 3]) * inverse;
+      area[k][i] = valid * ((1.0 - any_obtuse) * voronoi + any_obtuse * (quarter + obtuse[k] * quarter));
+      weight[k][i] = valid * (use_max * squared[k] * inverse_product + (1.0 - use_max));
+    }
+  }
+  for (int i = 0; i < count; ++i) {
+    FaceGeometry& g = records[first + i].geometry;
+    g.normal = {normal[0][i], normal[1][i], normal[2][i]};
+    for (int k = 0; k < 3; ++k) {
+      g.weight[k] = weight[k][i];
+      g.area[k] = area[k][i];
+    }
+  }
+}
+
 // Pass 2 for one face: least-squares fit of the second fundamental form (Rusinkiewicz 2004,
 // section 3: for each edge E from corner j to corner l, II (E.t, E.b) = ((N_l - N_j).t,
 // (N_l - N_j).b), six equations in e, f, g), then its transport to each corner's vertex frame.
@@ -252,27 +329,20 @@ std::uint8_t fit_and_transport(const Vertices& V, const Faces& F, const Vertices
   return left_out;
 }
 
-// Pass 2 for the faces [first, first + count), count <= kBlockFaces: fit_and_transport's
+// Pass 2 for the faces [first, first + count), count <= kBlock: fit_and_transport's
 // arithmetic on a block of faces at once, as loops over lanes of structure-of-arrays buffers
-// that the compiler vectorises (2 lanes with SSE2, 4 with AVX2 + FMA in the x86-64-v3 clone
-// picked at load time). This pass is most of the estimator's arithmetic; vectorised it runs
-// about 2.5x faster. The tail block is padded with copies of its last face, so every face is
-// computed in the same lane position whatever the thread partition (results do not depend on
-// the thread count). Faces this path does not handle (degenerate, or a normal matrix without
-// a positive, finite determinant) go through fit_and_transport.
+// that the compiler vectorises (VERTEXFLOW_SIMD_CLONES). This pass is most of the estimator's arithmetic; vectorised it
+// runs about 3x faster. Faces this path does not handle (degenerate, or a normal matrix without a positive, finite
+// determinant) go through fit_and_transport.
 //
 // The 3x3 solve is written out here because Eigen's fixed-size solvers do not run across SIMD
 // lanes. It is the cofactor inverse that Eigen's closed-form 3x3 inverse also uses, specialised
 // to this matrix [[a, b, 0], [b, a + c, b], [0, b, c]], whose determinant factors as
 // (a + c)(ac - b^2) = (sum of squared edge lengths) 12 area^2.
-constexpr int kBlockFaces = 64;
-
-#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
-__attribute__((target_clones("arch=x86-64-v3", "default")))
-#endif
+VERTEXFLOW_SIMD_CLONES
 void fit_and_transport_block(const Vertices& V, const Faces& F, const Vertices& N, Index first, int count,
                              FaceRecord* records, std::uint8_t* left_out) {
-  constexpr int L = kBlockFaces;
+  constexpr int L = kBlock;
   // [corner][coordinate][lane]
   alignas(64) double p[3][3][L], n[3][3][L], out[3][3][L];
   alignas(64) double area[3][L], folded[3][L], handled[L];
@@ -361,28 +431,58 @@ void fit_and_transport_block(const Vertices& V, const Faces& F, const Vertices& 
   }
 }
 
-// Diagonalises the vertex tensor (ku, kuv, kv), given in the unit frame, into k1 >= k2 and
-// T1, T2 (T1 x T2 = N).
-void diagonalize(const Tensor& tensor, const Frame& frame, Vec3 n, double& k1, double& k2, Vec3& t1, Vec3& t2) {
-  const double mean = 0.5 * (tensor.ku + tensor.kv);
-  const double half_difference = 0.5 * (tensor.ku - tensor.kv);
-  // Plain square roots: the operands are curvatures of a mesh whose size read_mesh bounds, far
-  // from overflow, and std::hypot's care costs more than the rest of this function.
-  const double radius = std::sqrt(half_difference * half_difference + tensor.kuv * tensor.kuv);
-  k1 = mean + radius;
-  k2 = mean - radius;
-  // Eigenvector of k1 in (u, w) coordinates: (radius + half_difference, kuv), or the
-  // equivalent (kuv, radius - half_difference) when that is better conditioned.
-  double x = radius + half_difference, y = tensor.kuv;
-  if (half_difference < 0) x = tensor.kuv, y = radius - half_difference;
-  const double length = std::sqrt(x * x + y * y);
-  if (length > 0) {
-    const double inverse = 1.0 / length;
-    t1 = (x * inverse) * frame.u + (y * inverse) * frame.w;
-  } else {  // umbilic: any direction
-    t1 = frame.u;
+// Pass 3 for the vertices [first, first + count), count <= kBlock: diagonalises each vertex's
+// tensor (ku, kuv, kv) in its frame (vertex_frame) into k1 >= k2 and T1, T2 (T1 x T2 = N), as
+// a branch-free loop over lanes (VERTEXFLOW_SIMD_CLONES).
+VERTEXFLOW_SIMD_CLONES
+void diagonalize_block(const Tensor* tensor, Index first, int count, Curvature& c) {
+  constexpr int L = kBlock;
+  alignas(64) double ku[L], kuv[L], kv[L], n[3][L], k1[L], k2[L], t1[3][L], t2[3][L];
+  for (int i = 0; i < L; ++i) {
+    const int j = i < count ? i : count - 1;
+    ku[i] = tensor[j].ku;
+    kuv[i] = tensor[j].kuv;
+    kv[i] = tensor[j].kv;
+    const Vec3 normal = row(c.N, first + j);
+    n[0][i] = normal.x;
+    n[1][i] = normal.y;
+    n[2][i] = normal.z;
   }
-  t2 = cross(n, t1);
+  for (int i = 0; i < L; ++i) {
+    const Vec3 normal{n[0][i], n[1][i], n[2][i]};
+    const Frame frame = vertex_frame(normal);
+    const double mean = 0.5 * (ku[i] + kv[i]);
+    const double half_difference = 0.5 * (ku[i] - kv[i]);
+    // Plain square roots: the operands are curvatures of a mesh whose size read_mesh bounds,
+    // far from overflow, and std::hypot's care costs more than the rest of this loop.
+    const double radius = std::sqrt(half_difference * half_difference + kuv[i] * kuv[i]);
+    k1[i] = mean + radius;
+    k2[i] = mean - radius;
+    // Eigenvector of k1 in (u, w) coordinates: (radius + half_difference, kuv), or the
+    // equivalent (kuv, radius - half_difference), whichever is better conditioned.
+    const double swap = static_cast<double>(half_difference < 0), keep = 1.0 - swap;
+    // At an umbilic both are 0 and any direction will do: the tiny shift of x then makes T1 = u
+    // (and changes nothing elsewhere), without a branch.
+    constexpr double kTiny = 1e-300;
+    const double x = keep * (radius + half_difference) + swap * kuv[i] + kTiny;
+    const double y = keep * kuv[i] + swap * (radius - half_difference);
+    const double inverse = 1.0 / (std::sqrt(x * x + y * y) + kTiny);
+    const Vec3 d1 = (x * inverse) * frame.u + (y * inverse) * frame.w;
+    const Vec3 d2 = cross(normal, d1);
+    t1[0][i] = d1.x;
+    t1[1][i] = d1.y;
+    t1[2][i] = d1.z;
+    t2[0][i] = d2.x;
+    t2[1][i] = d2.y;
+    t2[2][i] = d2.z;
+  }
+  for (int i = 0; i < count; ++i) {
+    const Index v = first + i;
+    c.k1[v] = k1[i];
+    c.k2[v] = k2[i];
+    set_row(c.T1, v, {t1[0][i], t1[1][i], t1[2][i]});
+    set_row(c.T2, v, {t2[0][i], t2[1][i], t2[2][i]});
+  }
 }
 
 }  // namespace
@@ -451,7 +551,13 @@ Curvature principal_curvatures(const Vertices& V, const Faces& F, const Topology
   };
 
   // Pass 1, per face: normal weights and mixed areas of the corners.
-  parallel_range(nf, [&](Index f) { record(f).geometry = face_geometry(V, F, f, options.normal_weighting); });
+  if (options.normal_weighting == NormalWeighting::Angle) {  // atan2 does not vectorise
+    parallel_range(nf, [&](Index f) { record(f).geometry = face_geometry(V, F, f, options.normal_weighting); });
+  } else {
+    parallel_blocks(nf, [&](Index first, int count) {
+      face_geometry_block(V, F, first, count, options.normal_weighting == NormalWeighting::Max1999, records.get());
+    });
+  }
 
   // Pass 1b, per vertex: unit normal and mixed area, summed over the incident faces in the
   // topology's fixed order.
@@ -471,13 +577,8 @@ Curvature principal_curvatures(const Vertices& V, const Faces& F, const Topology
   });
 
   // Pass 2, per face: fit and transport (fit_and_transport_block).
-  const Index num_blocks = (nf + kBlockFaces - 1) / kBlockFaces;
-  tbb::parallel_for(tbb::blocked_range<Index>(0, num_blocks, 32), [&](const tbb::blocked_range<Index>& r) {
-    for (Index block = r.begin(); block != r.end(); ++block) {
-      const Index first = block * kBlockFaces;
-      fit_and_transport_block(V, F, c.N, first, static_cast<int>(std::min<Index>(kBlockFaces, nf - first)),
-                              records.get(), left_out.get());
-    }
+  parallel_blocks(nf, [&](Index first, int count) {
+    fit_and_transport_block(V, F, c.N, first, count, records.get(), left_out.get());
   });
 
   // Pass 3, per vertex: the area-weighted mean of its corners' tensors (Rusinkiewicz 2004,
@@ -499,15 +600,12 @@ Curvature principal_curvatures(const Vertices& V, const Faces& F, const Topology
     const double inverse = 1.0 / weight;
     return Tensor{ku * inverse, kuv * inverse, kv * inverse};
   };
-  auto diagonalize_vertex = [&](Index v, const Tensor& tensor) {
-    const Vec3 n = row(c.N, v);
-    Vec3 t1, t2;
-    diagonalize(tensor, vertex_frame(n), n, c.k1[v], c.k2[v], t1, t2);
-    set_row(c.T1, v, t1);
-    set_row(c.T2, v, t2);
-  };
   if (options.smoothing_rounds <= 0) {
-    parallel_range(nv, [&](Index v) { diagonalize_vertex(v, vertex_tensor(v)); });
+    parallel_blocks(nv, [&](Index first, int count) {
+      Tensor tensor[kBlock];
+      for (int i = 0; i < count; ++i) tensor[i] = vertex_tensor(first + i);
+      diagonalize_block(tensor, first, count, c);
+    });
     return c;
   }
 
@@ -538,7 +636,9 @@ Curvature principal_curvatures(const Vertices& V, const Faces& F, const Topology
     });
     tensor = std::move(smoothed);
   }
-  parallel_range(nv, [&](Index v) { diagonalize_vertex(v, tensor[static_cast<std::size_t>(v)]); });
+  parallel_blocks(nv, [&](Index first, int count) {
+    diagonalize_block(&tensor[static_cast<std::size_t>(first)], first, count, c);
+  });
   return c;
 }
 
