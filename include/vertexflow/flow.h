@@ -100,12 +100,13 @@ struct FlowOptions {
 };
 
 struct FlowReport {
-  double mean_edge_length = 0;         ///< of the input: the unit of the normalised problem
-  double d = 0;                        ///< d of Eq. 6, in input units
-  double solver_error = 0;             ///< relative residual of the last solve's normal equations
+  double mean_edge_length = 0;  ///< of the input: the unit of the normalised problem
+  double d = 0;                 ///< d of Eq. 6, in input units
+  double solver_error = 0;      ///< relative residual of the last solve's normal equations
+  /// The guard runs after every solve (options.iterations); these sum over the solves.
   Index flipped_before_guard = 0;      ///< faces the unguarded solution turned or degenerated
   Index low_quality_before_guard = 0;  ///< faces it left below their quality floor
-  Index limited_vertices = 0;          ///< vertices whose displacement the guard shortened
+  Index limited_vertices = 0;          ///< vertices whose displacement the guard shortened (any solve)
   Index fixed_vertices = 0;            ///< boundary, pinned, isolated and corner vertices
   double seconds_curvature = 0, seconds_assembly = 0, seconds_solve = 0, seconds_projection = 0, seconds_guard = 0;
   /// Direct: CHOLMOD's analysis and numeric factorisation; iterative: the preconditioner.
