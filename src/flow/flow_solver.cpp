@@ -6,7 +6,7 @@
 // L the uniform Laplacian of Eq. 8, S = diag(mu mu_i / |V|) and D_i the 3x3 block of F_sd and
 // the pull:
 //   H = G P G + (L^T S L) (x) I_3 + D,     b = -(G P G P + L^T S (L P - R)),
-// R the fairness targets. So H x costs three passes over the one-rings (no matrix), and any
+// R the fairness targets. So H x costs two passes over the one-rings (no matrix), and any
 // block of H is a short sum over the vertices whose one-rings contain both of its vertices.
 //
 // - Direct: H's 3x3 blocks (two-ring pattern) assembled from that sum; a fill-reducing
@@ -21,8 +21,8 @@
 // Why these two and how the choice is made (measured on this project's meshes, docs/benchmarks.md):
 // the coupled factorisation costs about n^1.5 (3.1e9 flops at 9k vertices, 1.8e10 at 43k, an
 // estimated 2e12 and 16 GB at 1M), the iteration costs about n, and the iteration count stays
-// between 100 and 400 on smooth meshes of any size (bunny 9k: 106, armadillo 43k: 150,
-// armadillo subdivided to 1M: 320, to 1e-9) but reaches 1,300 where large flat regions leave
+// between 80 and 300 on smooth meshes of any size at the default tolerance 1e-7 (bunny 9k: 80,
+// amo 90k: 291; 98 and 416 at 1e-9) but reaches 900-1,100 where large flat regions leave
 // tangential motion to the bi-Laplacian of F_smo and the tiny pull (fandisk). Preconditioners
 // built on decoupled n x n factorisations (x, y, z, or per-vertex frames) and their two-level
 // combinations with Gauss-Seidel cost a factorisation each and still took 50-200 iterations,
@@ -132,7 +132,7 @@ void use_single_threaded_blas() {
 }
 
 // The per-vertex factors of H and b (see the top of this file), in normalised units, over the
-// vertices renumbered along a space-filling curve (`local` below): the operator gathers over
+// vertices renumbered breadth-first (`local` below, breadth_first_order): the operator gathers over
 // one-rings, and in a mesh's own order the neighbours of a vertex can be anywhere in memory
 // (the subdivided test mesh, amo.off). Measured: the iteration took 2-3x longer per vertex on
 // those meshes than on one whose file order is local (horse-48k).
@@ -182,6 +182,35 @@ std::vector<Index> space_filling_order(const Vertices& P) {
   tbb::parallel_sort(keys.begin(), keys.end());  // keys are unique, so the order is too
   std::vector<Index> order(static_cast<std::size_t>(n));
   for (std::size_t k = 0; k < keys.size(); ++k) order[k] = keys[k].second;
+  return order;
+}
+
+// Breadth-first (Cuthill-McKee) order of the vertex graph, each component started from its
+// first vertex in `seed_order` (the Morton order: a vertex near a corner of the bounding box,
+// so the breadth-first levels stay short). Every neighbour of a vertex is then within about
+// one level's width of it in memory, a few hundred to a few thousand vertices, so the
+// operator's gathers stay in the 2 MiB L2 cache; in Morton order a fraction of them jump far
+// (the curve's seams). Measured per iteration, 1 thread: amo 11.6 -> 8.5 ms; armadillo-1M,
+// 2 threads: 126 -> 77 ms.
+std::vector<Index> breadth_first_order(const Topology& topology, const std::vector<Index>& seed_order) {
+  const auto n = seed_order.size();
+  std::vector<Index> order;
+  order.reserve(n);
+  std::vector<char> seen(n, 0);
+  for (const Index seed : seed_order) {
+    if (seen[static_cast<std::size_t>(seed)]) continue;
+    seen[static_cast<std::size_t>(seed)] = 1;
+    std::size_t head = order.size();
+    order.push_back(seed);
+    while (head < order.size()) {
+      const auto [begin, end] = topology.ring(order[head++]);
+      for (const Index* j = begin; j != end; ++j) {
+        if (seen[static_cast<std::size_t>(*j)]) continue;
+        seen[static_cast<std::size_t>(*j)] = 1;
+        order.push_back(*j);
+      }
+    }
+  }
   return order;
 }
 
@@ -294,41 +323,47 @@ T chunked_sum(Index n, const T& zero, Body&& body) {
 }
 
 // H x (or, with with_d false and with_rest true, the part of H x - b that does not depend on D)
-// without forming H, in three passes over the one-rings: K x; q = P G x and r = S (L x - R)
-// (the weighted rows of F_tan and F_smo) with K q; then G q + L^T r + D x. The per-vertex
-// factors are stored as symmetric 3x3 (48 bytes) and the dot product x . y that conjugate
-// gradients need is summed in the last pass: about a third fewer bytes per iteration than full
-// 3x3 blocks and separate passes, while applying K once per vertex and per pass (applying it
-// per neighbour instead, with no K x array, saved more bytes but cost more time: the iteration
-// is as much bound by arithmetic as by memory here). Rows of fixed vertices are set to zero.
+// without forming H: a pointwise pass (K x), then two passes over the one-rings: q = P G x and
+// r = S (L x - R) (the weighted rows of F_tan and F_smo) with K q; then G q + L^T r + D x.
+// The per-vertex factors are stored as symmetric 3x3 (48 bytes) and the dot product x . y that
+// conjugate gradients need is summed in the last pass: about a third fewer bytes per iteration
+// than full 3x3 blocks and separate passes, while applying K once per vertex and pass (applying
+// it per neighbour instead, with no K x array, saved more bytes but cost more time: the
+// iteration is as much bound by arithmetic as by memory here). Rows of fixed vertices are zero.
 class Operator {
  public:
   explicit Operator(const Terms& terms) : t_(terms) {
-    const Eigen::Index size = 3 * static_cast<Eigen::Index>(t_.n);
-    kx_.resize(size);
-    q_.resize(size);
-    kq_.resize(size);
-    r_.resize(size);
+    const auto n = static_cast<std::size_t>(t_.n);
+    xkx_.resize(6 * n);
+    qkr_.resize(9 * n);
+    r_.resize(3 * static_cast<Eigen::Index>(n));
   }
 
   // Returns x . y (summed in chunks).
   double apply(const Vector& x, Vector& y, bool with_d, bool with_rest) {
-    parallel_vertices(t_.n, [&](Index i) { at(kx_, i) = t_.K[static_cast<std::size_t>(i)] * at(x, i); });
+    // What a vertex reads of its neighbours is interleaved in one record per vertex, so that a
+    // neighbour costs one or two cache lines instead of one per array: the gathers' cache
+    // misses were the hot spots of both one-ring passes.
+    parallel_vertices(t_.n, [&](Index i) {
+      const Vector3 xi = at(x, i);
+      record<6>(xkx_, i).head<3>() = xi;
+      record<6>(xkx_, i).tail<3>() = t_.K[static_cast<std::size_t>(i)] * xi;
+    });
     parallel_vertices(t_.n, [&](Index i) {
       const auto v = static_cast<std::size_t>(i);
       const auto [begin, end] = t_.one_ring(i);
-      Vector3 sum_x = Vector3::Zero(), sum_kx = Vector3::Zero();
-      for (const Index* j = begin; j != end; ++j) {
-        sum_x += at(x, *j);
-        sum_kx += at(kx_, *j);
-      }
-      const Vector3 xi = at(x, i);
-      const Vector3 q = t_.P[v] * Vector3(t_.G[v] * xi - t_.K[v] * sum_x - sum_kx);
-      at(q_, i) = q;
-      at(kq_, i) = t_.K[v] * q;
+      Eigen::Matrix<double, 6, 1> sum = Eigen::Matrix<double, 6, 1>::Zero();
+      for (const Index* j = begin; j != end; ++j) sum += record<6>(xkx_, *j);
+      const Vector3 xi = at(x, i), sum_x = sum.head<3>();
+      const Vector3 q = t_.P[v] * Vector3(t_.G[v] * xi - t_.K[v] * sum_x - sum.tail<3>());
       Vector3 laplacian = xi - t_.inv_degree[v] * sum_x;
       if (with_rest) laplacian -= t_.rest[v];
-      at(r_, i) = t_.smooth[v] * laplacian;
+      const Vector3 r = t_.smooth[v] * laplacian;
+      auto out = record<9>(qkr_, i);
+      out.head<3>() = q;
+      out.segment<3>(3) = t_.K[v] * q;
+      out.tail<3>() = t_.inv_degree[v] * r;
+      at(r_, i) = r;
     });
     // y = G q + L^T r (+ D x), G symmetric.
     return chunked_sum(t_.n, 0.0, [&](Index u) {
@@ -338,14 +373,10 @@ class Operator {
         return 0.0;
       }
       const auto [begin, end] = t_.one_ring(u);
-      Vector3 sum_q = Vector3::Zero(), sum_kq = Vector3::Zero(), sum_rd = Vector3::Zero();
-      for (const Index* j = begin; j != end; ++j) {
-        sum_q += at(q_, *j);
-        sum_kq += at(kq_, *j);
-        sum_rd += t_.inv_degree[static_cast<std::size_t>(*j)] * at(r_, *j);
-      }
-      const Vector3 xu = at(x, u);
-      Vector3 out = t_.G[v] * at(q_, u) - t_.K[v] * sum_q - sum_kq + at(r_, u) - sum_rd;
+      Eigen::Matrix<double, 9, 1> sum = Eigen::Matrix<double, 9, 1>::Zero();
+      for (const Index* j = begin; j != end; ++j) sum += record<9>(qkr_, *j);
+      const Vector3 xu = at(x, u), qu = record<9>(qkr_, u).head<3>();
+      Vector3 out = t_.G[v] * qu - t_.K[v] * Vector3(sum.head<3>()) - sum.segment<3>(3) + at(r_, u) - sum.tail<3>();
       if (with_d) out += t_.D[v] * xu;
       at(y, u) = out;
       return xu.dot(out);
@@ -353,8 +384,15 @@ class Operator {
   }
 
  private:
+  template <int Size>
+  static Eigen::Map<Eigen::Matrix<double, Size, 1>> record(std::vector<double>& data, Index i) {
+    return Eigen::Map<Eigen::Matrix<double, Size, 1>>(data.data() + Size * static_cast<std::size_t>(i));
+  }
+
   const Terms& t_;
-  Vector kx_, q_, kq_, r_;
+  std::vector<double> xkx_;  // per vertex: x, K x
+  std::vector<double> qkr_;  // per vertex: q, K q, r / degree
+  Vector r_;
 };
 
 // The 3x3 diagonal block of H at free vertex u: sum over the star of u of G_iu P_i G_iu and
@@ -489,7 +527,7 @@ struct FlowSystemSolver::Impl {
 
   void number_vertices(const Vertices& P) {
     if (!order.empty() || P.rows() == 0) return;
-    order = space_filling_order(P);
+    order = breadth_first_order(topology, space_filling_order(P));
     free_index.assign(order.size(), -1);
     for (std::size_t k = 0; k < order.size(); ++k) {
       if (fixed[static_cast<std::size_t>(order[k])]) continue;
