@@ -30,10 +30,13 @@ namespace vertexflow {
 
 /// How the flow's sparse linear system (the normal equations of flow_energy.h) is solved.
 enum class LinearSolver {
-  /// Conjugate gradients for meshes above a few thousand free vertices, falling back to the
-  /// direct factorisation when they have not converged within about the iterations the
-  /// factorisation would cost; the direct factorisation below that size. Deterministic: the
-  /// choice depends only on the mesh and the iteration count, never on timings.
+  /// The direct factorisation at or below 1,000 free vertices (a few milliseconds, exact).
+  /// Above, conjugate gradients; if they have not converged within 18 sqrt(free vertices)
+  /// iterations (about what the factorisation would cost on this project's reference machine),
+  /// the direct factorisation takes over when its predicted factor fits in 2 GiB, otherwise
+  /// the iteration continues up to ten times that budget. So the total is at most about twice
+  /// the cheaper method's (flow_solver.cpp explains the calibration). Deterministic: the choice
+  /// depends only on the mesh and the iteration count, never on timings.
   Automatic,
   /// Sparse Cholesky of the coupled 3n x 3n normal matrix (CHOLMOD). Exact to rounding, but its
   /// time grows like n^1.5 and its memory like n log n: about 2 GB at 100k vertices.
