@@ -70,6 +70,67 @@ std::vector<char> bad_faces(const GuardCriteria& criteria, const Vertices& after
   return bad;
 }
 
+// Guard (flow.h): halve the displacement from `anchor` (the positions before the round, not
+// bad) of every vertex of a bad face until no face is bad. Counts the bad faces in report
+// (summed over rounds) and marks the vertices it shortened.
+void guard(Vertices& X, const Vertices& anchor, const Vertices& input, const GuardCriteria& criteria,
+           const std::vector<char>& fixed, const Topology& topology, const SurfaceFeatures& features,
+           const FlowOptions& options, std::vector<char>& shortened, FlowReport& report) {
+  const Faces& F = criteria.F;
+  const Index n = static_cast<Index>(X.rows());
+  const Vertices displacement = X - anchor;
+  std::vector<double> step(static_cast<std::size_t>(n), 1.0);
+  std::vector<char> bad = bad_faces(criteria, X);
+  report.flipped_before_guard += static_cast<Index>(std::count(bad.begin(), bad.end(), kFlippedOrDegenerate));
+  report.low_quality_before_guard += static_cast<Index>(std::count(bad.begin(), bad.end(), kLowQuality));
+  // Each round halves every free vertex of a bad face once; after max_halvings rounds their
+  // displacement is zero, and a face whose vertices are all back at the anchor is not bad. Only
+  // the faces around the vertices a round moved are judged again.
+  std::vector<char> touched(static_cast<std::size_t>(n), 0);
+  std::vector<Index> bad_list;
+  for (Index f = 0; f < F.rows(); ++f) {
+    if (bad[static_cast<std::size_t>(f)]) bad_list.push_back(f);
+  }
+  for (int round = 1; !bad_list.empty(); ++round) {
+    std::vector<Index> moved, reproject;
+    for (const Index f : bad_list) {
+      for (int k = 0; k < 3; ++k) {
+        const Index i = F(f, k);
+        const auto v = static_cast<std::size_t>(i);
+        if (touched[v] || fixed[v]) continue;
+        touched[v] = 1;
+        moved.push_back(i);
+      }
+    }
+    std::sort(moved.begin(), moved.end());
+    for (const Index i : moved) {
+      const auto v = static_cast<std::size_t>(i);
+      touched[v] = 0;
+      step[v] = round >= options.max_halvings ? 0.0 : 0.5 * step[v];
+      shortened[v] = 1;
+      X.row(i) = anchor.row(i) + step[v] * displacement.row(i);
+      // Back onto the surface, except at step 0: the anchor itself, exactly.
+      if (step[v] != 0.0 && options.project_to_input) reproject.push_back(i);
+    }
+    project_near_vertices(X, reproject, input, F, topology, features);
+    std::vector<Index> faces;
+    for (const Index i : moved) {
+      for (Index k = topology.face_offsets[static_cast<std::size_t>(i)];
+           k < topology.face_offsets[static_cast<std::size_t>(i) + 1]; ++k)
+        faces.push_back(topology.vertex_faces[static_cast<std::size_t>(k)]);
+    }
+    std::sort(faces.begin(), faces.end());
+    faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
+    for (const Index f : faces) bad[static_cast<std::size_t>(f)] = face_badness(criteria, X, f);
+    bad_list.clear();
+    for (const Index f : faces) {
+      if (bad[static_cast<std::size_t>(f)]) bad_list.push_back(f);
+    }
+    // Bad faces away from the moved vertices cannot exist: they were bad before and so had all
+    // their free vertices moved (or all fixed, and then they are at the anchor and not bad).
+  }
+}
+
 // One solve: minimise the energy for positions X (normalised units), frozen curvature of X.
 Vertices solve_once(const Vertices& X, const Faces& F, const Topology& topology, FlowSystemSolver& solver,
                     const FlowOptions& options, FlowReport& report) {
@@ -150,7 +211,10 @@ FlowResult vertex_flow(const Vertices& V, const Faces& F, const FlowOptions& opt
   Vertices X = input;
   // One solver for all rounds: the connectivity is fixed, so its ordering is computed once.
   FlowSystemSolver solver(topology, fixed, options.solver, options.solver_tolerance);
+  const GuardCriteria criteria = guard_criteria(input, F, options.min_quality);
+  std::vector<char> shortened(static_cast<std::size_t>(n), 0);
   for (int round = 0; round < std::max(1, options.iterations); ++round) {
+    const Vertices start_of_round = X;
     X = solve_once(X, F, topology, solver, options, report);
     if (options.project_to_input) {
       const auto start = Clock::now();
@@ -161,65 +225,16 @@ FlowResult vertex_flow(const Vertices& V, const Faces& F, const FlowOptions& opt
       project_near_vertices(X, free_rows, input, F, topology, features);
       report.seconds_projection += seconds_since(start);
     }
+    // Guarded after every round, not only the last: the next round's curvature is estimated on
+    // X, and on the unguarded fandisk after three rounds (671 flipped or degenerate faces) it
+    // reached 1e15 per mean edge length, which made the normal matrix numerically indefinite.
+    const auto start = Clock::now();
+    guard(X, start_of_round, input, criteria, fixed, topology, features, options, shortened, report);
+    report.seconds_guard += seconds_since(start);
   }
 
-  // Guard: halve the displacement of every vertex of a bad face until no face is bad.
-  const auto start = Clock::now();
-  const GuardCriteria criteria = guard_criteria(input, F, options.min_quality);
-  const Vertices displacement = X - input;
-  std::vector<double> step(static_cast<std::size_t>(n), 1.0);
-  std::vector<char> bad = bad_faces(criteria, X);
-  report.flipped_before_guard = static_cast<Index>(std::count(bad.begin(), bad.end(), kFlippedOrDegenerate));
-  report.low_quality_before_guard = static_cast<Index>(std::count(bad.begin(), bad.end(), kLowQuality));
-  // Each round halves every free vertex of a bad face once; after max_halvings rounds their
-  // displacement is zero, and a face whose vertices are all back at the input is not bad. Only
-  // the faces around the vertices a round moved are judged again.
-  std::vector<char> shortened(static_cast<std::size_t>(n), 0), touched(static_cast<std::size_t>(n), 0);
-  std::vector<Index> bad_list;
-  for (Index f = 0; f < F.rows(); ++f) {
-    if (bad[static_cast<std::size_t>(f)]) bad_list.push_back(f);
-  }
-  for (int round = 1; !bad_list.empty(); ++round) {
-    std::vector<Index> moved, reproject;
-    for (const Index f : bad_list) {
-      for (int k = 0; k < 3; ++k) {
-        const Index i = F(f, k);
-        const auto v = static_cast<std::size_t>(i);
-        if (touched[v] || fixed[v]) continue;
-        touched[v] = 1;
-        moved.push_back(i);
-      }
-    }
-    std::sort(moved.begin(), moved.end());
-    for (const Index i : moved) {
-      const auto v = static_cast<std::size_t>(i);
-      touched[v] = 0;
-      step[v] = round >= options.max_halvings ? 0.0 : 0.5 * step[v];
-      shortened[v] = 1;
-      X.row(i) = input.row(i) + step[v] * displacement.row(i);
-      // Back onto the surface, except at step 0: the input position itself, exactly.
-      if (step[v] != 0.0 && options.project_to_input) reproject.push_back(i);
-    }
-    project_near_vertices(X, reproject, input, F, topology, features);
-    std::vector<Index> faces;
-    for (const Index i : moved) {
-      for (Index k = topology.face_offsets[static_cast<std::size_t>(i)];
-           k < topology.face_offsets[static_cast<std::size_t>(i) + 1]; ++k)
-        faces.push_back(topology.vertex_faces[static_cast<std::size_t>(k)]);
-    }
-    std::sort(faces.begin(), faces.end());
-    faces.erase(std::unique(faces.begin(), faces.end()), faces.end());
-    for (const Index f : faces) bad[static_cast<std::size_t>(f)] = face_badness(criteria, X, f);
-    bad_list.clear();
-    for (const Index f : faces) {
-      if (bad[static_cast<std::size_t>(f)]) bad_list.push_back(f);
-    }
-    // Bad faces away from the moved vertices cannot exist: they were bad before and so had all
-    // their free vertices moved (or all fixed, and then they are at the input and not bad).
-  }
   report.limited_vertices = static_cast<Index>(std::count(shortened.begin(), shortened.end(), 1));
   report.d *= scale;
-  report.seconds_guard = seconds_since(start);
 
   result.V = (X * scale).rowwise() + centroid;
   // Fixed vertices are returned bit for bit.

@@ -6,7 +6,7 @@
 // L the uniform Laplacian of Eq. 8, S = diag(mu mu_i / |V|) and D_i the 3x3 block of F_sd and
 // the pull:
 //   H = G P G + (L^T S L) (x) I_3 + D,     b = -(G P G P + L^T S (L P - R)),
-// R the fairness targets. So H x costs three passes over the one-rings (no matrix), and any
+// R the fairness targets. So H x costs two passes over the one-rings (no matrix), and any
 // block of H is a short sum over the vertices whose one-rings contain both of its vertices.
 //
 // - Direct: H's 3x3 blocks (two-ring pattern) assembled from that sum; a fill-reducing
@@ -21,8 +21,8 @@
 // Why these two and how the choice is made (measured on this project's meshes, docs/benchmarks.md):
 // the coupled factorisation costs about n^1.5 (3.1e9 flops at 9k vertices, 1.8e10 at 43k, an
 // estimated 2e12 and 16 GB at 1M), the iteration costs about n, and the iteration count stays
-// between 100 and 400 on smooth meshes of any size (bunny 9k: 106, armadillo 43k: 150,
-// armadillo subdivided to 1M: 320, to 1e-9) but reaches 1,300 where large flat regions leave
+// between 80 and 300 on smooth meshes of any size at the default tolerance 1e-7 (bunny 9k: 80,
+// amo 90k: 291; 98 and 416 at 1e-9) but reaches 900-1,100 where large flat regions leave
 // tangential motion to the bi-Laplacian of F_smo and the tiny pull (fandisk). Preconditioners
 // built on decoupled n x n factorisations (x, y, z, or per-vertex frames) and their two-level
 // combinations with Gauss-Seidel cost a factorisation each and still took 50-200 iterations,
@@ -58,6 +58,24 @@ namespace {
 using Matrix3 = Eigen::Matrix3d;
 using Vector3 = Eigen::Vector3d;
 using Vector = Eigen::VectorXd;  // 3 entries per vertex, x0 y0 z0 x1 ... (Vertices' layout)
+
+// A symmetric 3x3 matrix stored as its upper triangle: the per-vertex factors of H are all
+// symmetric, and the iteration is bound by memory traffic, so 48 bytes instead of 72 matter.
+struct Sym3 {
+  double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+
+  Sym3() = default;
+  explicit Sym3(const Matrix3& m) : xx(m(0, 0)), xy(m(0, 1)), xz(m(0, 2)), yy(m(1, 1)), yz(m(1, 2)), zz(m(2, 2)) {}
+  [[nodiscard]] Matrix3 full() const {
+    Matrix3 m;
+    m << xx, xy, xz, xy, yy, yz, xz, yz, zz;
+    return m;
+  }
+  [[nodiscard]] Vector3 operator*(const Vector3& v) const {
+    return {xx * v.x() + xy * v.y() + xz * v.z(), xy * v.x() + yy * v.y() + yz * v.z(),
+            xz * v.x() + yz * v.y() + zz * v.z()};
+  }
+};
 
 // Free vertices at or below this count are factored directly: a few milliseconds, exact, and
 // no iteration count to depend on (sphere_low, 589 vertices: 20 ms CPU direct, 1 ms iterating).
@@ -114,7 +132,7 @@ void use_single_threaded_blas() {
 }
 
 // The per-vertex factors of H and b (see the top of this file), in normalised units, over the
-// vertices renumbered along a space-filling curve (`local` below): the operator gathers over
+// vertices renumbered breadth-first (`local` below, breadth_first_order): the operator gathers over
 // one-rings, and in a mesh's own order the neighbours of a vertex can be anywhere in memory
 // (the subdivided test mesh, amo.off). Measured: the iteration took 2-3x longer per vertex on
 // those meshes than on one whose file order is local (horse-48k).
@@ -124,10 +142,10 @@ struct Terms {
   std::vector<Index> local;             // mesh vertex -> local index
   std::vector<Index> ring_start, ring;  // one-rings in local indices
   std::vector<char> fixed;
-  std::vector<Matrix3> K;  // K_i
-  std::vector<Matrix3> G;  // diagonal block of G: deg(i) K_i + sum_j K_j
-  std::vector<Matrix3> P;  // 1/|E| times the tangent projector
-  std::vector<Matrix3> D;  // F_sd and pull
+  std::vector<Sym3> K;  // K_i
+  std::vector<Sym3> G;  // diagonal block of G: deg(i) K_i + sum_j K_j
+  std::vector<Sym3> P;  // 1/|E| times the tangent projector
+  std::vector<Sym3> D;  // F_sd and pull
   std::vector<double> smooth, inv_degree;
   std::vector<Vector3> rest;  // fairness target r_i
 
@@ -167,6 +185,35 @@ std::vector<Index> space_filling_order(const Vertices& P) {
   return order;
 }
 
+// Breadth-first (Cuthill-McKee) order of the vertex graph, each component started from its
+// first vertex in `seed_order` (the Morton order: a vertex near a corner of the bounding box,
+// so the breadth-first levels stay short). Every neighbour of a vertex is then within about
+// one level's width of it in memory, a few hundred to a few thousand vertices, so the
+// operator's gathers stay in the 2 MiB L2 cache; in Morton order a fraction of them jump far
+// (the curve's seams). Measured per iteration, 1 thread: amo 11.6 -> 8.5 ms; armadillo-1M,
+// 2 threads: 126 -> 77 ms.
+std::vector<Index> breadth_first_order(const Topology& topology, const std::vector<Index>& seed_order) {
+  const auto n = seed_order.size();
+  std::vector<Index> order;
+  order.reserve(n);
+  std::vector<char> seen(n, 0);
+  for (const Index seed : seed_order) {
+    if (seen[static_cast<std::size_t>(seed)]) continue;
+    seen[static_cast<std::size_t>(seed)] = 1;
+    std::size_t head = order.size();
+    order.push_back(seed);
+    while (head < order.size()) {
+      const auto [begin, end] = topology.ring(order[head++]);
+      for (const Index* j = begin; j != end; ++j) {
+        if (seen[static_cast<std::size_t>(*j)]) continue;
+        seen[static_cast<std::size_t>(*j)] = 1;
+        order.push_back(*j);
+      }
+    }
+  }
+  return order;
+}
+
 Terms make_terms(const Topology& topology, const std::vector<char>& fixed, const FlowFrame& frame,
                  const EnergyWeights& weights, std::vector<Index> order) {
   Terms t;
@@ -202,11 +249,13 @@ Terms make_terms(const Topology& topology, const std::vector<char>& fixed, const
     const auto v = static_cast<std::size_t>(k);
     const Index i = t.original[v];
     const Vector3 t1 = c.T1.row(i).transpose(), t2 = c.T2.row(i).transpose(), normal = c.N.row(i).transpose();
-    t.K[v] = std::abs(c.k1[i]) * t1 * t1.transpose() + std::abs(c.k2[i]) * t2 * t2.transpose();
-    t.P[v] = w_em * (t1 * t1.transpose() + t2 * t2.transpose());
-    t.D[v] = w_sd * (distance_coefficient(frame.d, c.k1[i]) * t1 * t1.transpose() +
-                     distance_coefficient(frame.d, c.k2[i]) * t2 * t2.transpose() + normal * normal.transpose());
-    t.D[v].diagonal().array() += w_pull;
+    t.K[v] = Sym3(Matrix3(std::abs(c.k1[i]) * t1 * t1.transpose() + std::abs(c.k2[i]) * t2 * t2.transpose()));
+    t.P[v] = Sym3(Matrix3(w_em * (t1 * t1.transpose() + t2 * t2.transpose())));
+    Matrix3 distance =
+        w_sd * (distance_coefficient(frame.d, c.k1[i]) * t1 * t1.transpose() +
+                distance_coefficient(frame.d, c.k2[i]) * t2 * t2.transpose() + normal * normal.transpose());
+    distance.diagonal().array() += w_pull;
+    t.D[v] = Sym3(distance);
     const Index degree = topology.valence(i);
     t.inv_degree[v] = degree > 0 ? 1.0 / degree : 0.0;
     t.smooth[v] = degree > 0 ? weights.mu * std::exp(-(std::abs(c.k1[i]) + std::abs(c.k2[i]))) / nv : 0.0;
@@ -221,9 +270,9 @@ Terms make_terms(const Topology& topology, const std::vector<char>& fixed, const
   });
   parallel_vertices(t.n, [&](Index i) {
     const auto [begin, end] = t.one_ring(i);
-    Matrix3 sum = static_cast<double>(end - begin) * t.K[static_cast<std::size_t>(i)];
-    for (const Index* j = begin; j != end; ++j) sum += t.K[static_cast<std::size_t>(*j)];
-    t.G[static_cast<std::size_t>(i)] = sum;
+    Matrix3 sum = static_cast<double>(end - begin) * t.K[static_cast<std::size_t>(i)].full();
+    for (const Index* j = begin; j != end; ++j) sum += t.K[static_cast<std::size_t>(*j)].full();
+    t.G[static_cast<std::size_t>(i)] = Sym3(sum);
   });
   return t;
 }
@@ -246,81 +295,114 @@ void add_from_local(const Terms& t, const Vector& x, double* out) {
 
 // The block G_iu of G for u in the star (one-ring and itself) of i.
 Matrix3 g_block(const Terms& t, Index i, Index u) {
-  return i == u ? t.G[static_cast<std::size_t>(i)]
-                : Matrix3(-(t.K[static_cast<std::size_t>(i)] + t.K[static_cast<std::size_t>(u)]));
+  return i == u ? t.G[static_cast<std::size_t>(i)].full()
+                : Matrix3(-(t.K[static_cast<std::size_t>(i)].full() + t.K[static_cast<std::size_t>(u)].full()));
 }
 // The entry L_iu of the Laplacian.
 double l_entry(const Terms& t, Index i, Index u) {
   return i == u ? 1.0 : -t.inv_degree[static_cast<std::size_t>(i)];
 }
 
+// Vertices per chunk of the reductions: sums are taken per fixed chunk and the chunks' sums
+// added in order, so that their rounding does not depend on the threads.
+constexpr Index kChunk = 2048;
+
+// body(i) for every vertex i, returning the sum of its results (a double or an Eigen vector).
+template <class T, class Body>
+T chunked_sum(Index n, const T& zero, Body&& body) {
+  const Index chunks = (n + kChunk - 1) / kChunk;
+  std::vector<T> partial(static_cast<std::size_t>(chunks), zero);
+  tbb::parallel_for(Index{0}, chunks, [&](Index k) {
+    T sum = zero;
+    for (Index i = k * kChunk, end = std::min(n, (k + 1) * kChunk); i < end; ++i) sum += body(i);
+    partial[static_cast<std::size_t>(k)] = sum;
+  });
+  T total = zero;
+  for (const T& part : partial) total += part;
+  return total;
+}
+
 // H x (or, with with_d false and with_rest true, the part of H x - b that does not depend on D)
-// without forming H. Rows of fixed vertices are set to zero.
+// without forming H: a pointwise pass (K x), then two passes over the one-rings: q = P G x and
+// r = S (L x - R) (the weighted rows of F_tan and F_smo) with K q; then G q + L^T r + D x.
+// The per-vertex factors are stored as symmetric 3x3 (48 bytes) and the dot product x . y that
+// conjugate gradients need is summed in the last pass: about a third fewer bytes per iteration
+// than full 3x3 blocks and separate passes, while applying K once per vertex and pass (applying
+// it per neighbour instead, with no K x array, saved more bytes but cost more time: the
+// iteration is as much bound by arithmetic as by memory here). Rows of fixed vertices are zero.
 class Operator {
  public:
   explicit Operator(const Terms& terms) : t_(terms) {
-    const Eigen::Index size = 3 * static_cast<Eigen::Index>(t_.n);
-    kx_.resize(size);
-    q_.resize(size);
-    kq_.resize(size);
-    r_.resize(size);
-    rd_.resize(size);
+    const auto n = static_cast<std::size_t>(t_.n);
+    xkx_.resize(6 * n);
+    qkr_.resize(9 * n);
+    r_.resize(3 * static_cast<Eigen::Index>(n));
   }
 
-  void apply(const Vector& x, Vector& y, bool with_d, bool with_rest) {
-    parallel_vertices(t_.n, [&](Index i) { at(kx_, i) = t_.K[static_cast<std::size_t>(i)] * at(x, i); });
-    // q = P G x and r = S (L x - R): the rows of F_tan and F_smo, weighted.
+  // Returns x . y (summed in chunks).
+  double apply(const Vector& x, Vector& y, bool with_d, bool with_rest) {
+    // What a vertex reads of its neighbours is interleaved in one record per vertex, so that a
+    // neighbour costs one or two cache lines instead of one per array: the gathers' cache
+    // misses were the hot spots of both one-ring passes.
+    parallel_vertices(t_.n, [&](Index i) {
+      const Vector3 xi = at(x, i);
+      record<6>(xkx_, i).head<3>() = xi;
+      record<6>(xkx_, i).tail<3>() = t_.K[static_cast<std::size_t>(i)] * xi;
+    });
     parallel_vertices(t_.n, [&](Index i) {
       const auto v = static_cast<std::size_t>(i);
       const auto [begin, end] = t_.one_ring(i);
-      Vector3 sum_x = Vector3::Zero(), sum_kx = Vector3::Zero();
-      for (const Index* j = begin; j != end; ++j) {
-        sum_x += at(x, *j);
-        sum_kx += at(kx_, *j);
-      }
-      const Vector3 xi = at(x, i);
-      const Vector3 g = t_.G[v] * xi - t_.K[v] * sum_x - sum_kx;
-      const Vector3 q = t_.P[v] * g;
-      at(q_, i) = q;
-      at(kq_, i) = t_.K[v] * q;
+      Eigen::Matrix<double, 6, 1> sum = Eigen::Matrix<double, 6, 1>::Zero();
+      for (const Index* j = begin; j != end; ++j) sum += record<6>(xkx_, *j);
+      const Vector3 xi = at(x, i), sum_x = sum.head<3>();
+      const Vector3 q = t_.P[v] * Vector3(t_.G[v] * xi - t_.K[v] * sum_x - sum.tail<3>());
       Vector3 laplacian = xi - t_.inv_degree[v] * sum_x;
       if (with_rest) laplacian -= t_.rest[v];
-      at(r_, i) = t_.smooth[v] * laplacian;
-      at(rd_, i) = t_.smooth[v] * t_.inv_degree[v] * laplacian;
+      const Vector3 r = t_.smooth[v] * laplacian;
+      auto out = record<9>(qkr_, i);
+      out.head<3>() = q;
+      out.segment<3>(3) = t_.K[v] * q;
+      out.tail<3>() = t_.inv_degree[v] * r;
+      at(r_, i) = r;
     });
-    // y = G q + L^T r (+ D x).
-    parallel_vertices(t_.n, [&](Index u) {
+    // y = G q + L^T r (+ D x), G symmetric.
+    return chunked_sum(t_.n, 0.0, [&](Index u) {
       const auto v = static_cast<std::size_t>(u);
       if (t_.fixed[v]) {
         at(y, u).setZero();
-        return;
+        return 0.0;
       }
       const auto [begin, end] = t_.one_ring(u);
-      Vector3 sum_q = Vector3::Zero(), sum_kq = Vector3::Zero(), sum_rd = Vector3::Zero();
-      for (const Index* j = begin; j != end; ++j) {
-        sum_q += at(q_, *j);
-        sum_kq += at(kq_, *j);
-        sum_rd += at(rd_, *j);
-      }
-      Vector3 out = t_.G[v] * at(q_, u) - t_.K[v] * sum_q - sum_kq + at(r_, u) - sum_rd;
-      if (with_d) out += t_.D[v] * at(x, u);
+      Eigen::Matrix<double, 9, 1> sum = Eigen::Matrix<double, 9, 1>::Zero();
+      for (const Index* j = begin; j != end; ++j) sum += record<9>(qkr_, *j);
+      const Vector3 xu = at(x, u), qu = record<9>(qkr_, u).head<3>();
+      Vector3 out = t_.G[v] * qu - t_.K[v] * Vector3(sum.head<3>()) - sum.segment<3>(3) + at(r_, u) - sum.tail<3>();
+      if (with_d) out += t_.D[v] * xu;
       at(y, u) = out;
+      return xu.dot(out);
     });
   }
 
  private:
+  template <int Size>
+  static Eigen::Map<Eigen::Matrix<double, Size, 1>> record(std::vector<double>& data, Index i) {
+    return Eigen::Map<Eigen::Matrix<double, Size, 1>>(data.data() + Size * static_cast<std::size_t>(i));
+  }
+
   const Terms& t_;
-  Vector kx_, q_, kq_, r_, rd_;
+  std::vector<double> xkx_;  // per vertex: x, K x
+  std::vector<double> qkr_;  // per vertex: q, K q, r / degree
+  Vector r_;
 };
 
 // The 3x3 diagonal block of H at free vertex u: sum over the star of u of G_iu P_i G_iu and
 // S_i L_iu^2, plus D_u.
 Matrix3 diagonal_block(const Terms& t, Index u) {
-  Matrix3 block = t.D[static_cast<std::size_t>(u)];
+  Matrix3 block = t.D[static_cast<std::size_t>(u)].full();
   double laplacian = 0;
   auto add = [&](Index i) {
     const Matrix3 g = g_block(t, i, u);
-    block.noalias() += g * t.P[static_cast<std::size_t>(i)] * g;
+    block.noalias() += g * t.P[static_cast<std::size_t>(i)].full() * g;
     laplacian += t.smooth[static_cast<std::size_t>(i)] * l_entry(t, i, u) * l_entry(t, i, u);
   };
   add(u);
@@ -336,53 +418,61 @@ struct IterationResult {
 };
 
 // Preconditioned conjugate gradients from d = 0 (the input positions). Each run() continues
-// for at most max_iterations, stopping when |r| <= tolerance |b|.
+// for at most max_iterations, stopping when |r| <= tolerance |b|. The vector updates, the
+// preconditioner and the two dot products they need share one pass (memory traffic, as in
+// Operator).
 class ConjugateGradients {
  public:
   ConjugateGradients(const Terms& terms, Operator& op, const Vector& b) : t_(terms), op_(op) {
     inverse_.resize(static_cast<std::size_t>(t_.n));
     parallel_vertices(t_.n, [&](Index u) {
       const auto v = static_cast<std::size_t>(u);
-      inverse_[v] = t_.fixed[v] ? Matrix3::Zero() : Matrix3(diagonal_block(t_, u).inverse());
+      if (!t_.fixed[v]) inverse_[v] = Sym3(Matrix3(diagonal_block(t_, u).inverse()));
     });
     d_.setZero(b.size());
     r_ = b;
     z_.resize(b.size());
-    p_.resize(b.size());
     hp_.resize(b.size());
-    precondition();
+    rz_ = chunked_sum(t_.n, 0.0, [&](Index i) {
+      at(z_, i) = inverse_[static_cast<std::size_t>(i)] * at(r_, i);
+      return at(r_, i).dot(at(z_, i));
+    });
     p_ = z_;
-    rz_ = dot(r_, z_);
     b_norm_ = std::sqrt(dot(b, b));
+    r_norm_ = b_norm_;
   }
 
   IterationResult run(int max_iterations, double tolerance) {
     IterationResult result;
     const double target = tolerance * b_norm_;
-    if (std::sqrt(dot(r_, r_)) <= target) {
+    if (r_norm_ <= target) {
       result.converged = true;
       return result;
     }
     while (result.iterations < max_iterations) {
-      op_.apply(p_, hp_, true, false);
-      const double curvature = dot(p_, hp_);
+      const double curvature = op_.apply(p_, hp_, true, false);
       if (!(curvature > 0)) break;  // H is positive definite; only rounding at convergence gets here
       const double alpha = rz_ / curvature;
-      tbb::parallel_for(Index{0}, t_.n, [&](Index i) {
+      // d += alpha p, r -= alpha H p, z = M^-1 r; sums of r.r and r.z.
+      const Eigen::Vector2d sums = chunked_sum(t_.n, Eigen::Vector2d::Zero().eval(), [&](Index i) {
         at(d_, i) += alpha * at(p_, i);
-        at(r_, i) -= alpha * at(hp_, i);
+        const Vector3 r = at(r_, i) - alpha * at(hp_, i);
+        const Vector3 z = inverse_[static_cast<std::size_t>(i)] * r;
+        at(r_, i) = r;
+        at(z_, i) = z;
+        return Eigen::Vector2d(r.squaredNorm(), r.dot(z));
       });
+      r_norm_ = std::sqrt(sums[0]);
+      const double rz = sums[1];
       ++result.iterations;
       ++total_iterations_;
-      if (std::sqrt(dot(r_, r_)) <= target) {
+      if (r_norm_ <= target) {
         result.converged = true;
         break;
       }
-      precondition();
-      const double rz = dot(r_, z_);
       const double beta = rz / rz_;
       rz_ = rz;
-      tbb::parallel_for(Index{0}, t_.n, [&](Index i) { at(p_, i) = at(z_, i) + beta * at(p_, i); });
+      parallel_vertices(t_.n, [&](Index i) { at(p_, i) = at(z_, i) + beta * at(p_, i); });
     }
     return result;
   }
@@ -391,15 +481,11 @@ class ConjugateGradients {
   int total_iterations() const { return total_iterations_; }
 
  private:
-  void precondition() {
-    tbb::parallel_for(Index{0}, t_.n, [&](Index i) { at(z_, i) = inverse_[static_cast<std::size_t>(i)] * at(r_, i); });
-  }
-
   const Terms& t_;
   Operator& op_;
-  std::vector<Matrix3> inverse_;
+  std::vector<Sym3> inverse_;  // of H's diagonal blocks; zero at fixed vertices
   Vector d_, r_, z_, p_, hp_;
-  double rz_ = 0, b_norm_ = 0;
+  double rz_ = 0, b_norm_ = 0, r_norm_ = 0;
   int total_iterations_ = 0;
 };
 
@@ -441,7 +527,7 @@ struct FlowSystemSolver::Impl {
 
   void number_vertices(const Vertices& P) {
     if (!order.empty() || P.rows() == 0) return;
-    order = space_filling_order(P);
+    order = breadth_first_order(topology, space_filling_order(P));
     free_index.assign(order.size(), -1);
     for (std::size_t k = 0; k < order.size(); ++k) {
       if (fixed[static_cast<std::size_t>(order[k])]) continue;
@@ -555,7 +641,7 @@ cholmod_sparse* FlowSystemSolver::Impl::assemble(const Terms& t) {
     const Index u = free_vertex[static_cast<std::size_t>(a)];
     // Block (u, w) = sum over i whose star holds u and w of G_iu P_i G_iw + S_i L_iu L_iw I.
     auto add_star = [&](Index i) {
-      const Matrix3 left = g_block(t, i, u) * t.P[static_cast<std::size_t>(i)];
+      const Matrix3 left = g_block(t, i, u) * t.P[static_cast<std::size_t>(i)].full();
       const double l_u = t.smooth[static_cast<std::size_t>(i)] * l_entry(t, i, u);
       auto add = [&](Index w) {
         const std::int64_t k = position[static_cast<std::size_t>(w)];
@@ -571,7 +657,7 @@ cholmod_sparse* FlowSystemSolver::Impl::assemble(const Terms& t) {
     add_star(u);
     const auto [begin, end] = t.one_ring(u);
     for (const Index* i = begin; i != end; ++i) add_star(*i);
-    blocks.back() += t.D[static_cast<std::size_t>(u)];
+    blocks.back() += t.D[static_cast<std::size_t>(u)].full();
     for (auto k = first; k < last; ++k)
       position[static_cast<std::size_t>(
           free_vertex[static_cast<std::size_t>(row_columns[static_cast<std::size_t>(k)])])] = -1;

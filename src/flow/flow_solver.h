@@ -23,7 +23,7 @@ class FlowSystemSolver {
  public:
   /// `fixed` marks the vertices held at frame.P; `kind` and `tolerance` as in FlowOptions.
   FlowSystemSolver(const Topology& topology, std::vector<char> fixed, LinearSolver kind = LinearSolver::Automatic,
-                   double tolerance = 1e-9);
+                   double tolerance = 1e-7);
   ~FlowSystemSolver();
   FlowSystemSolver(const FlowSystemSolver&) = delete;
   FlowSystemSolver& operator=(const FlowSystemSolver&) = delete;
