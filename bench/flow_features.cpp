@@ -1,13 +1,14 @@
-// Experiment: what the flow's feature detection marks on a mesh.
+// Experiment (not a benchmark): what the flow's feature detection (surface_projection.h) marks on
+// a mesh: sharp edges, creases, corners and patches at a given feature angle.
 #include "../src/flow/surface_projection.h"
 #include "vertexflow/curvature.h"
 #include "vertexflow/io.h"
 #include "vertexflow/topology.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <algorithm>
 #include <functional>
 #include <map>
 #include <vector>
@@ -15,6 +16,10 @@
 using namespace vertexflow;
 
 int main(int argc, char** argv) {
+  if (argc < 3) {
+    std::fprintf(stderr, "usage: flow_features FEATURE_ANGLE_DEGREES MESH...\n");
+    return 2;
+  }
   const double angle = std::atof(argv[1]);
   for (int a = 2; a < argc; ++a) {
     const Mesh m = read_mesh(argv[a]);
@@ -86,15 +91,22 @@ int main(int argc, char** argv) {
         }
       std::sort(ratios.begin(), ratios.end());
       int above2 = 0, above3 = 0;
-      for (double r : ratios) { above2 += r >= 2; above3 += r >= 3; }
+      for (double r : ratios) {
+        above2 += r >= 2;
+        above3 += r >= 3;
+      }
       if (!ratios.empty())
         std::printf("  jump ratio over %zu edges: p10 %.2f p50 %.2f p90 %.2f; >=2: %d >=3: %d\n", ratios.size(),
-                    ratios[ratios.size() / 10], ratios[ratios.size() / 2], ratios[ratios.size() * 9 / 10], above2, above3);
+                    ratios[ratios.size() / 10], ratios[ratios.size() / 2], ratios[ratios.size() * 9 / 10], above2,
+                    above3);
     }
     std::printf("  components:");
     for (auto& [r, d] : comp) {
       double mean = 0, mx = 0;
-      for (double x : d) { mean += x / d.size(); mx = std::max(mx, x); }
+      for (double x : d) {
+        mean += x / d.size();
+        mx = std::max(mx, x);
+      }
       std::printf(" [%zu e, mean %.0f max %.0f, %d corners]", d.size(), mean, mx, corners[r]);
     }
     std::printf("\n");

@@ -1,12 +1,17 @@
-// Experiment: what Spearman rho(|k1|+|k2|, 1/A_i) could an idealised redistribution reach on a
-// mesh's connectivity? Prints several bounds (see the report).
+// Experiment (not a benchmark): what Spearman rho(|k1|+|k2|, 1/A_i) could an idealised
+// redistribution reach on a mesh's connectivity? Prints, per mesh, the input's rho, the rho of
+// face areas set to 1 / (mean |k1|+|k2| of the corners) and to 1 / sqrt(|k1 k2|), the rho
+// between k and its one-ring mean (the estimator-noise ceiling), and log-linear blends from the
+// input's areas to the first ideal with how much each face's area would have to change.
+//
+//   build/bin/flow_ideal data/max-planck-5k.obj
 #include "vertexflow/curvature.h"
 #include "vertexflow/io.h"
 #include "vertexflow/metrics.h"
 #include "vertexflow/topology.h"
 
-#include <cmath>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <vector>
 

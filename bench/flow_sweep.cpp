@@ -2,10 +2,10 @@
 // meshes with options given as key=value (lambda mu dp eps iters proj fa minq fair) and prints
 // the acceptance figures of the quality issue, one line per mesh, from compare_meshes.
 #include "vertexflow/compare.h"
+#include "vertexflow/curvature.h"
 #include "vertexflow/flow.h"
 #include "vertexflow/io.h"
 #include "vertexflow/metrics.h"
-#include "vertexflow/curvature.h"
 #include "vertexflow/quality.h"
 #include "vertexflow/topology.h"
 
@@ -24,19 +24,34 @@ int main(int argc, char** argv) {
   for (int a = 1; a < argc; ++a) {
     std::string s = argv[a];
     const auto eq = s.find('=');
-    if (eq == std::string::npos) { meshes.push_back(s); continue; }
+    if (eq == std::string::npos) {
+      meshes.push_back(s);
+      continue;
+    }
     const std::string k = s.substr(0, eq);
     const double v = std::atof(s.substr(eq + 1).c_str());
-    if (k == "lambda") o.lambda = v;
-    else if (k == "mu") o.mu = v;
-    else if (k == "dp") o.d_percentile = v;
-    else if (k == "eps") o.epsilon = v;
-    else if (k == "iters") o.iterations = static_cast<int>(v);
-    else if (k == "proj") o.project_to_input = v != 0;
-    else if (k == "fa") o.feature_angle = v;
-    else if (k == "minq") o.min_quality = v;
-    else if (k == "fair") o.fairness_target = v != 0 ? FairnessTarget::InputNormal : FairnessTarget::Zero;
-    else { std::fprintf(stderr, "unknown %s\n", k.c_str()); return 2; }
+    if (k == "lambda")
+      o.lambda = v;
+    else if (k == "mu")
+      o.mu = v;
+    else if (k == "dp")
+      o.d_percentile = v;
+    else if (k == "eps")
+      o.epsilon = v;
+    else if (k == "iters")
+      o.iterations = static_cast<int>(v);
+    else if (k == "proj")
+      o.project_to_input = v != 0;
+    else if (k == "fa")
+      o.feature_angle = v;
+    else if (k == "minq")
+      o.min_quality = v;
+    else if (k == "fair")
+      o.fairness_target = v != 0 ? FairnessTarget::InputNormal : FairnessTarget::Zero;
+    else {
+      std::fprintf(stderr, "unknown %s\n", k.c_str());
+      return 2;
+    }
   }
   for (const auto& path : meshes) {
     const Mesh in = read_mesh(path);
@@ -66,7 +81,8 @@ int main(int argc, char** argv) {
     // Does the flow move the density the way |k1|+|k2| asks? Spearman between the per-vertex change
     // of log density and the change the isotropic ideal (density proportional to k) asks for.
     const Eigen::VectorXd din = vertex_density(in.V, in.F), dout = vertex_density(out.V, in.F);
-    const Eigen::VectorXd kin = principal_curvatures(in.V, in.F, build_topology(in.F, in.num_vertices())).absolute_sum();
+    const Eigen::VectorXd kin =
+        principal_curvatures(in.V, in.F, build_topology(in.F, in.num_vertices())).absolute_sum();
     Eigen::VectorXd got(in.num_vertices()), want(in.num_vertices());
     for (Index i = 0; i < in.num_vertices(); ++i) {
       got[i] = std::log(std::max(dout[i], 1e-300) / std::max(din[i], 1e-300));
@@ -79,10 +95,10 @@ int main(int argc, char** argv) {
         "flip %ld degen %ld fixed %ld limited %ld lowq_bg %ld disp %.3f dA %.2f/%.2f\n",
         name.c_str(), c.redistribution_rho_input, c.redistribution_rho_result,
         c.redistribution_rho_result - c.redistribution_rho_input, cvi, cvo, 100 * (cvo - cvi) / cvi, minq,
-        good ? 100.0 * below / good : 0.0, c.result_input.a_to_b.mean / unit, vb != 0 ? 100 * (va - vb) / std::abs(vb) : 0.0,
-        static_cast<long>(c.flipped_faces.value_or(0)), static_cast<long>(c.degenerate_faces_result),
-        static_cast<long>(r.report.fixed_vertices), static_cast<long>(r.report.limited_vertices),
-        static_cast<long>(r.report.low_quality_before_guard),
+        good ? 100.0 * below / good : 0.0, c.result_input.a_to_b.mean / unit,
+        vb != 0 ? 100 * (va - vb) / std::abs(vb) : 0.0, static_cast<long>(c.flipped_faces.value_or(0)),
+        static_cast<long>(c.degenerate_faces_result), static_cast<long>(r.report.fixed_vertices),
+        static_cast<long>(r.report.limited_vertices), static_cast<long>(r.report.low_quality_before_guard),
         (r.V - in.V).rowwise().norm().mean() / unit, change[change.size() / 2], change[change.size() * 9 / 10]);
     std::fflush(stdout);
   }
