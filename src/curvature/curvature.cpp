@@ -110,43 +110,50 @@ struct FaceGeometry {
   double area[3];
 };
 
-FaceGeometry face_geometry(Vec3 p0, Vec3 p1, Vec3 p2, NormalWeighting weighting) {
+// Written without branches (flags are 0/1 doubles, and the divisors of a degenerate face are
+// shifted off zero and its results multiplied by 0), so that face_geometry_block vectorises it.
+// use_max: 1 for the Max1999 weighting, 0 for Area.
+inline FaceGeometry face_geometry_kernel(Vec3 p0, Vec3 p1, Vec3 p2, double use_max) {
   // Edge k is opposite corner k; at corner k the two edges are -edge[k + 2] and edge[k + 1].
   const Vec3 edge[3] = {p2 - p1, p0 - p2, p1 - p0};
-  FaceGeometry g{cross(edge[2], -edge[1]), {0, 0, 0}, {0, 0, 0}};
+  FaceGeometry g;
+  g.normal = cross(edge[2], -edge[1]);
   const double length = std::sqrt(squared_norm(g.normal));
-  if (!(length > 0)) return g;
+  const double valid = static_cast<double>(length > 0), invalid = 1.0 - valid;
   const double squared[3] = {squared_norm(edge[0]), squared_norm(edge[1]), squared_norm(edge[2])};
   const double dots[3] = {-dot(edge[2], edge[1]), -dot(edge[0], edge[2]), -dot(edge[1], edge[0])};  // < 0: obtuse
-
-  switch (weighting) {
-    case NormalWeighting::Max1999: {
-      // 1 / (|edge k+1|^2 |edge k+2|^2) = |edge k|^2 / (product of all three).
-      const double inverse = 1.0 / (squared[0] * squared[1] * squared[2]);
-      for (int k = 0; k < 3; ++k) g.weight[k] = squared[k] * inverse;
-      break;
-    }
-    case NormalWeighting::Area:
-      for (double& w : g.weight) w = 1;
-      break;
-    case NormalWeighting::Angle:
-      for (int k = 0; k < 3; ++k) g.weight[k] = std::atan2(length, dots[k]) / length;
-      break;
-  }
-
-  const double face_area = 0.5 * length;
+  // Max1999: 1 / (|edge k+1|^2 |edge k+2|^2) = |edge k|^2 / (product of all three).
+  const double inverse_product = 1.0 / (squared[0] * squared[1] * squared[2] + invalid);
+  // Obtuse at k: half the face to k, a quarter to each other corner. At most one corner is
+  // obtuse; if rounding makes two, the first counts.
+  const double obtuse0 = static_cast<double>(dots[0] < 0);
+  const double obtuse1 = static_cast<double>(dots[1] < 0) * (1.0 - obtuse0);
+  const double obtuse2 = static_cast<double>(dots[2] < 0) * (1.0 - obtuse0) * (1.0 - obtuse1);
+  const double obtuse[3] = {obtuse0, obtuse1, obtuse2};
+  const double any_obtuse = obtuse0 + obtuse1 + obtuse2;
+  const double quarter = 0.125 * length, inverse = 1.0 / (8.0 * length + invalid);
+#pragma GCC unroll 3
   for (int k = 0; k < 3; ++k) {
-    if (dots[k] < 0) {  // obtuse at k: half to k, a quarter to each other corner
-      g.area[k] = 0.5 * face_area;
-      g.area[(k + 1) % 3] = g.area[(k + 2) % 3] = 0.25 * face_area;
-      return g;
+    // Voronoi region of corner k: (|edge k+2|^2 cot(angle at k+2) + |edge k+1|^2 cot(angle at
+    // k+1)) / 8, with cot(angle at m) = dots[m] / length.
+    const double voronoi =
+        (squared[(k + 2) % 3] * dots[(k + 2) % 3] + squared[(k + 1) % 3] * dots[(k + 1) % 3]) * inverse;
+    g.area[k] = valid * ((1.0 - any_obtuse) * voronoi + any_obtuse * (quarter + obtuse[k] * quarter));
+    g.weight[k] = valid * (use_max * squared[k] * inverse_product + (1.0 - use_max));
+  }
+  return g;
+}
+
+FaceGeometry face_geometry(Vec3 p0, Vec3 p1, Vec3 p2, NormalWeighting weighting) {
+  FaceGeometry g = face_geometry_kernel(p0, p1, p2, weighting == NormalWeighting::Max1999 ? 1.0 : 0.0);
+  if (weighting == NormalWeighting::Angle) {
+    const double length = std::sqrt(squared_norm(g.normal));
+    if (!(length > 0)) return g;
+    const Vec3 p[3] = {p0, p1, p2};
+    for (int k = 0; k < 3; ++k) {  // the corner's angle / length
+      g.weight[k] = std::atan2(length, dot(p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k])) / length;
     }
   }
-  // Voronoi region of corner k: (|edge k+2|^2 cot(angle at k+2) + |edge k+1|^2 cot(angle at
-  // k+1)) / 8, with cot(angle at m) = dots[m] / length.
-  const double inverse = 1.0 / (8.0 * length);
-  for (int k = 0; k < 3; ++k)
-    g.area[k] = (squared[(k + 2) % 3] * dots[(k + 2) % 3] + squared[(k + 1) % 3] * dots[(k + 1) % 3]) * inverse;
   return g;
 }
 
@@ -203,10 +210,9 @@ union FaceRecord {
 };
 static_assert(sizeof(FaceGeometry) == sizeof(Tensor[3]));
 
-// Pass 1 for the faces [first, first + count), count <= kBlock: face_geometry for the Max1999
-// (max_weighting) or Area weighting, as a branch-free loop over lanes that the compiler
-// vectorises (VERTEXFLOW_SIMD_CLONES). Flags are 0/1 doubles; divisors of degenerate faces are
-// shifted off zero and their results multiplied by 0.
+// Pass 1 for the faces [first, first + count), count <= kBlock: face_geometry_kernel for the
+// Max1999 (max_weighting) or Area weighting, as a loop over lanes that the compiler vectorises
+// (VERTEXFLOW_SIMD_CLONES).
 VERTEXFLOW_SIMD_CLONES
 void face_geometry_block(const Vertices& V, const Faces& F, Index first, int count, bool max_weighting,
                          FaceRecord* records) {
@@ -221,31 +227,15 @@ void face_geometry_block(const Vertices& V, const Faces& F, Index first, int cou
   }
   const double use_max = max_weighting ? 1.0 : 0.0;
   for (int i = 0; i < L; ++i) {
-    const Vec3 p0{p[0][0][i], p[0][1][i], p[0][2][i]}, p1{p[1][0][i], p[1][1][i], p[1][2][i]},
-        p2{p[2][0][i], p[2][1][i], p[2][2][i]};
-    const Vec3 edge[3] = {p2 - p1, p0 - p2, p1 - p0};
-    const Vec3 n = cross(edge[2], -edge[1]);
-    const double length = std::sqrt(squared_norm(n));
-    const double valid = static_cast<double>(length > 0), invalid = 1.0 - valid;
-    const double squared[3] = {squared_norm(edge[0]), squared_norm(edge[1]), squared_norm(edge[2])};
-    const double dots[3] = {-dot(edge[2], edge[1]), -dot(edge[0], edge[2]), -dot(edge[1], edge[0])};
-    const double inverse_product = 1.0 / (squared[0] * squared[1] * squared[2] + invalid);
-    // At most one corner is obtuse; if rounding makes two, the first counts (as face_geometry).
-    const double obtuse0 = static_cast<double>(dots[0] < 0);
-    const double obtuse1 = static_cast<double>(dots[1] < 0) * (1.0 - obtuse0);
-    const double obtuse2 = static_cast<double>(dots[2] < 0) * (1.0 - obtuse0) * (1.0 - obtuse1);
-    const double obtuse[3] = {obtuse0, obtuse1, obtuse2};
-    const double any_obtuse = obtuse0 + obtuse1 + obtuse2;
-    const double quarter = 0.125 * length, inverse = 1.0 / (8.0 * length + invalid);
-    normal[0][i] = n.x;
-    normal[1][i] = n.y;
-    normal[2][i] = n.z;
-#pragma GCC unroll 3
+    const FaceGeometry g =
+        face_geometry_kernel({p[0][0][i], p[0][1][i], p[0][2][i]}, {p[1][0][i], p[1][1][i], p[1][2][i]},
+                             {p[2][0][i], p[2][1][i], p[2][2][i]}, use_max);
+    normal[0][i] = g.normal.x;
+    normal[1][i] = g.normal.y;
+    normal[2][i] = g.normal.z;
     for (int k = 0; k < 3; ++k) {
-      const double voronoi =
-          (squared[(k + 2) % 3] * dots[(k + 2) % 3] + squared[(k + 1) % 3] * dots[(k + 1) % 3]) * inverse;
-      area[k][i] = valid * ((1.0 - any_obtuse) * voronoi + any_obtuse * (quarter + obtuse[k] * quarter));
-      weight[k][i] = valid * (use_max * squared[k] * inverse_product + (1.0 - use_max));
+      weight[k][i] = g.weight[k];
+      area[k][i] = g.area[k];
     }
   }
   for (int i = 0; i < count; ++i) {
@@ -258,9 +248,54 @@ void face_geometry_block(const Vertices& V, const Faces& F, Index first, int cou
   }
 }
 
-// Pass 2 for one face: least-squares fit of the second fundamental form (Rusinkiewicz 2004,
-// section 3: for each edge E from corner j to corner l, II (E.t, E.b) = ((N_l - N_j).t,
-// (N_l - N_j).b), six equations in e, f, g), then its transport to each corner's vertex frame.
+// The least-squares fit of one face's second fundamental form II = [[e, f], [f, g]]
+// (Rusinkiewicz 2004, section 3): for each edge E from corner j to corner l,
+// II (E.t, E.b) = ((N_l - N_j).t, (N_l - N_j).b), six equations in e, f, g, given by their
+// normal equations [[uu, uv, 0], [uv, uu + vv, uv], [0, uv, vv]] (e, f, g) = r, in the face
+// frame (t, face_normal x t) with t along edge 0. Without branches (fit_and_transport_block
+// vectorises it): for a degenerate face (normal_squared or edge_squared 0) the frame is not
+// finite, and the caller must not use the result.
+struct FitSystem {
+  Vec3 t, face_normal;
+  double normal_squared, edge_squared;
+  double uu, uv, vv, r0, r1, r2;
+};
+inline FitSystem fit_system(const Vec3 (&p)[3], const Vec3 (&n)[3]) {
+  FitSystem s;
+  // Edge k is opposite corner k: from corner k + 1 to corner k + 2.
+  const Vec3 edge0 = p[2] - p[1], edge1 = p[0] - p[2];
+  const Vec3 normal = cross(edge0, edge1);  // = (p1 - p0) x (p2 - p0)
+  s.normal_squared = squared_norm(normal);
+  s.edge_squared = squared_norm(edge0);
+  const double edge_length = std::sqrt(s.edge_squared);
+  // Reciprocals: one division per normalised vector.
+  s.t = (1.0 / edge_length) * edge0;
+  s.face_normal = (1.0 / std::sqrt(s.normal_squared)) * normal;
+  const Vec3 b = cross(s.face_normal, s.t);
+  // Edge and normal-difference coordinates (u, v) and (dnu, dnv) in the frame (t, b). Edge 0 is
+  // t's own edge, and edges and normal differences both sum to zero around the face, so two
+  // edges give all three.
+  const Vec3 dn0 = n[2] - n[1], dn1 = n[0] - n[2];
+  const double u1 = dot(edge1, s.t), v1 = dot(edge1, b);
+  const double u[3] = {edge_length, u1, -edge_length - u1}, v[3] = {0, v1, -v1};
+  const double dnu0 = dot(dn0, s.t), dnu1 = dot(dn1, s.t), dnv0 = dot(dn0, b), dnv1 = dot(dn1, b);
+  const double dnu[3] = {dnu0, dnu1, -dnu0 - dnu1}, dnv[3] = {dnv0, dnv1, -dnv0 - dnv1};
+  // Normal equations of the rows (u, v, 0) . (e, f, g) = dnu and (0, u, v) . (e, f, g) = dnv.
+  s.uu = s.uv = s.vv = s.r0 = s.r1 = s.r2 = 0;
+#pragma GCC unroll 3
+  for (int k = 0; k < 3; ++k) {
+    s.uu += u[k] * u[k];
+    s.uv += u[k] * v[k];
+    s.vv += v[k] * v[k];
+    s.r0 += u[k] * dnu[k];
+    s.r1 += v[k] * dnu[k] + u[k] * dnv[k];
+    s.r2 += v[k] * dnv[k];
+  }
+  return s;
+}
+
+// Pass 2 for one face: the fit of fit_system, solved with Eigen, then its transport to each
+// corner's vertex frame.
 // Returns a bit per corner left out of its vertex's average (degenerate, failed or folded).
 std::uint8_t fit_and_transport(const Vertices& V, const Faces& F, const Vertices& N, Index face, FaceRecord& record) {
   const double area[3] = {record.geometry.area[0], record.geometry.area[1], record.geometry.area[2]};
@@ -268,36 +303,10 @@ std::uint8_t fit_and_transport(const Vertices& V, const Faces& F, const Vertices
   const Index* corner = face_row(F, face);
   const Vec3 p[3] = {row(V, corner[0]), row(V, corner[1]), row(V, corner[2])};
   const Vec3 n[3] = {row(N, corner[0]), row(N, corner[1]), row(N, corner[2])};
-  // Edge k is opposite corner k: from corner k + 1 to corner k + 2.
-  const Vec3 edge0 = p[2] - p[1], edge1 = p[0] - p[2];
-  const Vec3 normal = cross(edge0, edge1);  // = (p1 - p0) x (p2 - p0)
-  const double normal_length = std::sqrt(squared_norm(normal));
-  const double edge_length = std::sqrt(squared_norm(edge0));
+  const FitSystem system = fit_system(p, n);
   const std::uint8_t all_left_out = (area[0] > 0 ? 1 : 0) | (area[1] > 0 ? 2 : 0) | (area[2] > 0 ? 4 : 0);
-  if (!(normal_length > 0) || !(edge_length > 0)) return all_left_out;
-  // Reciprocals: one division per normalised vector.
-  const Vec3 t = (1.0 / edge_length) * edge0;
-  const Vec3 face_normal = (1.0 / normal_length) * normal;
-  const Vec3 b = cross(face_normal, t);
-
-  // Edge and normal-difference coordinates (u, v) and (dnu, dnv) in the frame (t, b). Edge 0 is
-  // t's own edge, and edges and normal differences both sum to zero around the face, so two
-  // edges give all three.
-  const Vec3 dn0 = n[2] - n[1], dn1 = n[0] - n[2];
-  const double u[3] = {edge_length, dot(edge1, t), -edge_length - dot(edge1, t)};
-  const double v[3] = {0, dot(edge1, b), -dot(edge1, b)};
-  const double dnu0 = dot(dn0, t), dnu1 = dot(dn1, t), dnv0 = dot(dn0, b), dnv1 = dot(dn1, b);
-  const double dnu[3] = {dnu0, dnu1, -dnu0 - dnu1}, dnv[3] = {dnv0, dnv1, -dnv0 - dnv1};
-  // Normal equations of the rows (u, v, 0) . (e, f, g) = dnu and (0, u, v) . (e, f, g) = dnv.
-  double uu = 0, uv = 0, vv = 0, r0 = 0, r1 = 0, r2 = 0;
-  for (int k = 0; k < 3; ++k) {
-    uu += u[k] * u[k];
-    uv += u[k] * v[k];
-    vv += v[k] * v[k];
-    r0 += u[k] * dnu[k];
-    r1 += v[k] * dnu[k] + u[k] * dnv[k];
-    r2 += v[k] * dnv[k];
-  }
+  if (!(system.normal_squared > 0) || !(system.edge_squared > 0)) return all_left_out;
+  const auto& [t, face_normal, normal_squared, edge_squared, uu, uv, vv, r0, r1, r2] = system;
   Eigen::Matrix3d normal_matrix;
   normal_matrix << uu, uv, 0, uv, uu + vv, uv, 0, uv, vv;
   const Eigen::Vector3d rhs(r0, r1, r2);
@@ -364,34 +373,13 @@ void fit_and_transport_block(const Vertices& V, const Faces& F, const Vertices& 
   }
 
   for (int i = 0; i < L; ++i) {
-    const Vec3 p0{p[0][0][i], p[0][1][i], p[0][2][i]}, p1{p[1][0][i], p[1][1][i], p[1][2][i]},
-        p2{p[2][0][i], p[2][1][i], p[2][2][i]};
+    const Vec3 pv[3] = {{p[0][0][i], p[0][1][i], p[0][2][i]},
+                        {p[1][0][i], p[1][1][i], p[1][2][i]},
+                        {p[2][0][i], p[2][1][i], p[2][2][i]}};
     const Vec3 nv[3] = {{n[0][0][i], n[0][1][i], n[0][2][i]},
                         {n[1][0][i], n[1][1][i], n[1][2][i]},
                         {n[2][0][i], n[2][1][i], n[2][2][i]}};
-    const Vec3 edge0 = p2 - p1, edge1 = p0 - p2;
-    const Vec3 normal = cross(edge0, edge1);
-    const double normal_squared = squared_norm(normal), edge_squared = squared_norm(edge0);
-    const double edge_length = std::sqrt(edge_squared);
-    const Vec3 t = (1.0 / edge_length) * edge0;
-    const Vec3 face_normal = (1.0 / std::sqrt(normal_squared)) * normal;
-    const Vec3 b = cross(face_normal, t);
-    // As in fit_and_transport: (u, v) of the edges, (dnu, dnv) of the normal differences.
-    const Vec3 dn0 = nv[2] - nv[1], dn1 = nv[0] - nv[2];
-    const double u1 = dot(edge1, t), v1 = dot(edge1, b);
-    const double u[3] = {edge_length, u1, -edge_length - u1}, v[3] = {0, v1, -v1};
-    const double dnu0 = dot(dn0, t), dnu1 = dot(dn1, t), dnv0 = dot(dn0, b), dnv1 = dot(dn1, b);
-    const double dnu[3] = {dnu0, dnu1, -dnu0 - dnu1}, dnv[3] = {dnv0, dnv1, -dnv0 - dnv1};
-    double uu = 0, uv = 0, vv = 0, r0 = 0, r1 = 0, r2 = 0;
-#pragma GCC unroll 3
-    for (int k = 0; k < 3; ++k) {
-      uu += u[k] * u[k];
-      uv += u[k] * v[k];
-      vv += v[k] * v[k];
-      r0 += u[k] * dnu[k];
-      r1 += v[k] * dnu[k] + u[k] * dnv[k];
-      r2 += v[k] * dnv[k];
-    }
+    const auto [t, face_normal, normal_squared, edge_squared, uu, uv, vv, r0, r1, r2] = fit_system(pv, nv);
     // Cofactor solve of [[uu, uv, 0], [uv, uu + vv, uv], [0, uv, vv]] (e, f, g) = (r0, r1, r2).
     const double trace = uu + vv, gram = uu * vv - uv * uv;
     const double determinant = trace * gram;
