@@ -11,14 +11,14 @@
 namespace vertexflow {
 namespace {
 
+using test::quoted_data_path;
 using test::run_cli;
 using test::shell_quote;
 
 // Shell-quoted path of a bundled mesh.
-std::string data(const std::string& name) { return shell_quote(test::data_path(name).string()); }
 
 TEST(CliInfo, PrintsTheSummary) {
-  const auto r = run_cli("info " + data("torus.obj"));
+  const auto r = run_cli("info " + quoted_data_path("torus.obj"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("vertices              2304"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("genus                 1"), std::string::npos) << r.out;
@@ -27,7 +27,7 @@ TEST(CliInfo, PrintsTheSummary) {
 }
 
 TEST(CliInfo, JsonHasTheSameNumbers) {
-  const auto r = run_cli("info --json " + data("hemisphere.off"));
+  const auto r = run_cli("info --json " + quoted_data_path("hemisphere.off"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["vertices"], 1861);
@@ -46,14 +46,14 @@ TEST(CliInfo, JsonHasTheSameNumbers) {
 }
 
 TEST(CliInfo, PolygonMeshWarningsAndTopology) {
-  const auto r = run_cli("info --json " + data("suzanne.obj"));
+  const auto r = run_cli("info --json " + quoted_data_path("suzanne.obj"));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   EXPECT_EQ(j["components"], 3);
   EXPECT_EQ(j["boundary_loops"], 4);
   // Warnings about triangulation go to stderr, one line each, and not with --quiet.
   EXPECT_NE(r.err.find("468 polygons triangulated"), std::string::npos) << r.err;
-  EXPECT_TRUE(run_cli("--quiet info " + data("suzanne.obj")).err.empty());
+  EXPECT_TRUE(run_cli("--quiet info " + quoted_data_path("suzanne.obj")).err.empty());
 }
 
 TEST(CliInfo, MissingFileIsOneLineErrorAndExitCode1) {
@@ -82,7 +82,7 @@ namespace {
 TEST(CliCurvature, WritesPropertiesAndColours) {
   test::ScratchDir dir("cli-curvature");
   const auto out = dir.file("torus.ply");
-  const auto r = test::run_cli("curvature " + data("torus.obj") + " " + test::shell_quote(out.string()) +
+  const auto r = test::run_cli("curvature " + quoted_data_path("torus.obj") + " " + test::shell_quote(out.string()) +
                                " --color mean --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
@@ -105,12 +105,14 @@ TEST(CliCurvature, RefusesToOverwriteTheInputAndNonManifoldMeshes) {
   const auto copy = dir.file("in.ply");
   std::filesystem::copy_file(test::data_path("horse-48k.ply"), copy);
   const std::string before = test::read_text(copy);
-  const auto r = test::run_cli("curvature " + test::shell_quote(copy.string()) + " " + test::shell_quote(copy.string()));
+  const auto r =
+      test::run_cli("curvature " + test::shell_quote(copy.string()) + " " + test::shell_quote(copy.string()));
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("refusing to overwrite"), std::string::npos) << r.err;
   EXPECT_EQ(test::read_text(copy), before);
 
-  const auto nm = test::run_cli("curvature " + data("suzanne.obj") + " " + test::shell_quote(dir.file("s.ply").string()));
+  const auto nm = test::run_cli("curvature " + quoted_data_path("suzanne.obj") + " " +
+                                test::shell_quote(dir.file("s.ply").string()));
   EXPECT_EQ(nm.exit_code, 0) << nm.err;  // suzanne triangulates to a manifold mesh
   const auto bad = dir.file("bowtie.obj");
   { std::ofstream(bad) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv -1 0 0\nv 0 -1 0\nf 1 2 3\nf 1 4 5\n"; }
@@ -133,8 +135,8 @@ TEST(CliEnhance, WritesTheMeshAndAReport) {
   const auto report = dir.file("report.json");
   const auto pins = dir.file("pins.txt");
   { std::ofstream(pins) << "# hold two vertices\n17 4000\n"; }
-  const auto r = run_cli("enhance " + data("bunny_uniform.off") + " " + shell_quote(out.string()) + " --pin " +
-                         shell_quote(pins.string()) + " --report " + shell_quote(report.string()));
+  const auto r = run_cli("enhance " + quoted_data_path("bunny_uniform.off") + " " + shell_quote(out.string()) +
+                         " --pin " + shell_quote(pins.string()) + " --report " + shell_quote(report.string()));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const Mesh input = read_mesh(test::data_path("bunny_uniform.off"));
   const Mesh result = read_mesh(out);
@@ -160,7 +162,7 @@ TEST(CliEnhance, BadPinFileAndNonManifoldInputFailCleanly) {
   const auto pins = dir.file("pins.txt");
   { std::ofstream(pins) << "12 banana\n"; }
   const auto out = dir.file("out.off");
-  const auto r = run_cli("enhance " + data("spot.obj") + " " + shell_quote(out.string()) + " --pin " +
+  const auto r = run_cli("enhance " + quoted_data_path("spot.obj") + " " + shell_quote(out.string()) + " --pin " +
                          shell_quote(pins.string()));
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("line 1: 'banana' is not a vertex index"), std::string::npos) << r.err;
@@ -186,8 +188,8 @@ TEST(CliEnhance, SameBytesWhateverTheBlasThreadCount) {
   for (int threads : {1, 2}) {
     const auto out = dir.file("out" + std::to_string(threads) + ".ply");
     const auto r = test::run_command("OPENBLAS_NUM_THREADS=" + std::to_string(threads) + " " +
-                                     shell_quote(VERTEXFLOW_CLI) + " --quiet enhance " + data("max-planck-5k.obj") + " " +
-                                     shell_quote(out.string()));
+                                     shell_quote(VERTEXFLOW_CLI) + " --quiet enhance " +
+                                     quoted_data_path("max-planck-5k.obj") + " " + shell_quote(out.string()));
     ASSERT_EQ(r.exit_code, 0) << r.err;
     outputs[threads - 1] = test::read_text(out);
   }
@@ -198,7 +200,7 @@ TEST(CliEnhance, SameBytesWhateverTheBlasThreadCount) {
 TEST(CliEnhance, RefusesAReportOverTheOutput) {
   test::ScratchDir dir("cli-enhance-report");
   const auto out = dir.file("out.ply");
-  const auto r = run_cli("enhance " + data("spot.obj") + " " + shell_quote(out.string()) + " --report " +
+  const auto r = run_cli("enhance " + quoted_data_path("spot.obj") + " " + shell_quote(out.string()) + " --report " +
                          shell_quote(out.string()));
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("the report would overwrite the output mesh"), std::string::npos) << r.err;

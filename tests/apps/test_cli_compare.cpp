@@ -12,12 +12,9 @@
 namespace vertexflow {
 namespace {
 
+using test::quoted_data_path;
 using test::run_cli;
 using test::shell_quote;
-
-std::string data(const std::string& name) {
-  return shell_quote(test::data_path(name).string());
-}
 
 TEST(CliCompare, JsonHasEveryMetricAndMatchesTheLibrary) {
   test::ScratchDir dir("cli-compare-json");
@@ -27,8 +24,8 @@ TEST(CliCompare, JsonHasEveryMetricAndMatchesTheLibrary) {
   result.V.row(100) += 0.2 * (result.V.row(101) - result.V.row(100));
   const auto result_file = dir.file("result.ply");
   write_mesh(result_file, result);
-  const auto r = run_cli("compare " + shell_quote(result_file.string()) + " " + data("bunny_uniform.off") +
-                         " --reference " + data("bunny.off") + " --json --samples 20000 --seed 5");
+  const auto r = run_cli("compare " + shell_quote(result_file.string()) + " " + quoted_data_path("bunny_uniform.off") +
+                         " --reference " + quoted_data_path("bunny.off") + " --json --samples 20000 --seed 5");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   for (const char* key :
@@ -72,8 +69,8 @@ TEST(CliCompare, JsonHasEveryMetricAndMatchesTheLibrary) {
 
 TEST(CliCompare, TableAndNotApplicableFlips) {
   // Different connectivity (two remeshes of the bunny): flips cannot be defined.
-  const auto r =
-      run_cli("compare " + data("bunny_adaptive.off") + " " + data("bunny_uniform.off") + " --samples 10000");
+  const auto r = run_cli("compare " + quoted_data_path("bunny_adaptive.off") + " " +
+                         quoted_data_path("bunny_uniform.off") + " --samples 10000");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   for (const char* text :
        {"result -> input", "input -> result", "Hausdorff result, input", "redistribution rho", "edge error CV",
@@ -81,8 +78,8 @@ TEST(CliCompare, TableAndNotApplicableFlips) {
     EXPECT_NE(r.out.find(text), std::string::npos) << text << "\n" << r.out;
   EXPECT_EQ(r.out.find("reference"), std::string::npos) << r.out;  // no reference given
 
-  const auto js =
-      run_cli("compare " + data("bunny_adaptive.off") + " " + data("bunny_uniform.off") + " --samples 10000 --json");
+  const auto js = run_cli("compare " + quoted_data_path("bunny_adaptive.off") + " " +
+                          quoted_data_path("bunny_uniform.off") + " --samples 10000 --json");
   ASSERT_EQ(js.exit_code, 0) << js.err;
   const auto j = nlohmann::json::parse(js.out);
   EXPECT_EQ(j["flipped_faces"]["applicable"], false);
@@ -95,28 +92,31 @@ TEST(CliCompare, TableAndNotApplicableFlips) {
 
 TEST(CliCompare, BadInputsAreOneLineErrors) {
   test::ScratchDir dir("cli-compare-bad");
-  const auto missing = run_cli("compare /nonexistent/result.off " + data("sphere_low.off"));
+  const auto missing = run_cli("compare /nonexistent/result.off " + quoted_data_path("sphere_low.off"));
   EXPECT_EQ(missing.exit_code, 1);
   EXPECT_EQ(missing.err.rfind("vertexflow: error: /nonexistent/result.off: ", 0), 0u) << missing.err;
   EXPECT_EQ(std::count(missing.err.begin(), missing.err.end(), '\n'), 1) << missing.err;
   EXPECT_TRUE(missing.out.empty());
 
   const auto empty = test::test_data_path("bad/empty.off");
-  const auto bad = run_cli("compare " + data("sphere_low.off") + " " + shell_quote(empty.string()));
+  const auto bad = run_cli("compare " + quoted_data_path("sphere_low.off") + " " + shell_quote(empty.string()));
   EXPECT_EQ(bad.exit_code, 1);
   EXPECT_NE(bad.err.find(empty.string()), std::string::npos) << bad.err;
   EXPECT_EQ(std::count(bad.err.begin(), bad.err.end(), '\n'), 1) << bad.err;
 
   const auto bowtie = dir.file("bowtie.obj");
   { std::ofstream(bowtie) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv -1 0 0\nv 0 -1 0\nf 1 2 3\nf 1 4 5\n"; }
-  const auto nm = run_cli("--quiet compare " + data("sphere_low.off") + " " + data("sphere_low.off") + " --reference " +
-                          shell_quote(bowtie.string()));
+  const auto nm = run_cli("--quiet compare " + quoted_data_path("sphere_low.off") + " " +
+                          quoted_data_path("sphere_low.off") + " --reference " + shell_quote(bowtie.string()));
   EXPECT_EQ(nm.exit_code, 1);
   EXPECT_NE(nm.err.find("bowtie.obj: the reference mesh: the mesh is not manifold"), std::string::npos) << nm.err;
   EXPECT_EQ(std::count(nm.err.begin(), nm.err.end(), '\n'), 1) << nm.err;
 
-  EXPECT_NE(run_cli("compare " + data("sphere_low.off")).exit_code, 0);  // INPUT missing
-  EXPECT_NE(run_cli("compare " + data("sphere_low.off") + " " + data("sphere_low.off") + " --samples -5").exit_code, 0);
+  EXPECT_NE(run_cli("compare " + quoted_data_path("sphere_low.off")).exit_code, 0);  // INPUT missing
+  EXPECT_NE(run_cli("compare " + quoted_data_path("sphere_low.off") + " " + quoted_data_path("sphere_low.off") +
+                    " --samples -5")
+                .exit_code,
+            0);
 }
 
 }  // namespace

@@ -13,12 +13,9 @@
 namespace vertexflow {
 namespace {
 
+using test::quoted_data_path;
 using test::run_cli;
 using test::shell_quote;
-
-std::string data(const std::string& name) {
-  return shell_quote(test::data_path(name).string());
-}
 
 // One line on stderr, "vertexflow: error: ...", containing `text`; exit code 1; no output file.
 void expect_one_line_error(const test::CommandResult& r, const std::string& text) {
@@ -37,8 +34,8 @@ std::filesystem::path write_bowtie(const test::ScratchDir& dir) {
 TEST(CliSimplify, WritesTheBudgetAndASummary) {
   test::ScratchDir dir("cli-simplify");
   const auto out = dir.file("camel.ply");
-  const auto r =
-      run_cli("simplify " + data("camelhead.off") + " " + shell_quote(out.string()) + " --faces 3000 --json");
+  const auto r = run_cli("simplify " + quoted_data_path("camelhead.off") + " " + shell_quote(out.string()) +
+                         " --faces 3000 --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   const Mesh result = read_mesh(out);
@@ -55,7 +52,7 @@ TEST(CliSimplify, WritesTheBudgetAndASummary) {
 
   const auto half = dir.file("half.off");
   const auto ratio =
-      run_cli("--quiet simplify " + data("spot.obj") + " " + shell_quote(half.string()) + " --ratio 0.5");
+      run_cli("--quiet simplify " + quoted_data_path("spot.obj") + " " + shell_quote(half.string()) + " --ratio 0.5");
   ASSERT_EQ(ratio.exit_code, 0) << ratio.err;
   EXPECT_TRUE(ratio.err.empty()) << ratio.err;
   EXPECT_EQ(read_mesh(half).num_faces(), 2928);
@@ -67,15 +64,17 @@ TEST(CliSimplify, BadInputFailsCleanly) {
   expect_one_line_error(
       run_cli("simplify " + shell_quote(write_bowtie(dir).string()) + " " + shell_quote(out.string()) + " --faces 1"),
       "bowtie.obj: simplify: the mesh is not manifold");
-  expect_one_line_error(run_cli("simplify " + data("spot.obj") + " " + shell_quote(out.string()) + " --ratio 0"),
-                        "spot.obj: simplify: the target ratio must be in (0, 1]");
+  expect_one_line_error(
+      run_cli("simplify " + quoted_data_path("spot.obj") + " " + shell_quote(out.string()) + " --ratio 0"),
+      "spot.obj: simplify: the target ratio must be in (0, 1]");
   expect_one_line_error(run_cli("simplify /nonexistent/in.off " + shell_quote(out.string()) + " --faces 10"),
                         "/nonexistent/in.off: ");
   EXPECT_FALSE(std::filesystem::exists(out));
   // A usage error: neither or both budgets.
-  EXPECT_NE(run_cli("simplify " + data("spot.obj") + " " + shell_quote(out.string())).exit_code, 0);
+  EXPECT_NE(run_cli("simplify " + quoted_data_path("spot.obj") + " " + shell_quote(out.string())).exit_code, 0);
   EXPECT_NE(
-      run_cli("simplify " + data("spot.obj") + " " + shell_quote(out.string()) + " --faces 10 --ratio 0.5").exit_code,
+      run_cli("simplify " + quoted_data_path("spot.obj") + " " + shell_quote(out.string()) + " --faces 10 --ratio 0.5")
+          .exit_code,
       0);
   EXPECT_FALSE(std::filesystem::exists(out));
 }
@@ -83,8 +82,8 @@ TEST(CliSimplify, BadInputFailsCleanly) {
 TEST(CliRemesh, ReportsCountAndQuality) {
   test::ScratchDir dir("cli-remesh");
   const auto out = dir.file("fertility.obj");
-  const auto r =
-      run_cli("remesh " + data("fertility.off") + " " + shell_quote(out.string()) + " --target-vertices 1500 --json");
+  const auto r = run_cli("remesh " + quoted_data_path("fertility.off") + " " + shell_quote(out.string()) +
+                         " --target-vertices 1500 --json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto j = nlohmann::json::parse(r.out);
   const Mesh result = read_mesh(out);
@@ -98,8 +97,8 @@ TEST(CliRemesh, ReportsCountAndQuality) {
   EXPECT_EQ(build_topology(result.F, result.num_vertices()).genus(), 4);
 
   const auto fixed = dir.file("fixed.off");
-  const auto length =
-      run_cli("--quiet remesh " + data("torus.obj") + " " + shell_quote(fixed.string()) + " --edge-length 0.1");
+  const auto length = run_cli("--quiet remesh " + quoted_data_path("torus.obj") + " " + shell_quote(fixed.string()) +
+                              " --edge-length 0.1");
   ASSERT_EQ(length.exit_code, 0) << length.err;
   EXPECT_TRUE(length.err.empty()) << length.err;
   EXPECT_GT(read_mesh(fixed).num_vertices(), 100);
@@ -111,13 +110,17 @@ TEST(CliRemesh, BadInputFailsCleanly) {
   expect_one_line_error(run_cli("remesh " + shell_quote(write_bowtie(dir).string()) + " " + shell_quote(out.string()) +
                                 " --target-vertices 100"),
                         "bowtie.obj: remesh: the mesh is not manifold");
-  expect_one_line_error(run_cli("remesh " + data("spot.obj") + " " + shell_quote(out.string()) + " --edge-length 1e-7"),
-                        "spot.obj: remesh: the edge length 1e-07 would give about");
+  expect_one_line_error(
+      run_cli("remesh " + quoted_data_path("spot.obj") + " " + shell_quote(out.string()) + " --edge-length 1e-7"),
+      "spot.obj: remesh: the edge length 1e-07 would give about");
   EXPECT_FALSE(std::filesystem::exists(out));
-  EXPECT_NE(run_cli("remesh " + data("spot.obj") + " " + shell_quote(out.string())).exit_code, 0);
-  EXPECT_NE(run_cli("remesh " + data("spot.obj") + " " + shell_quote(out.string()) + " --target-vertices 2").exit_code,
+  EXPECT_NE(run_cli("remesh " + quoted_data_path("spot.obj") + " " + shell_quote(out.string())).exit_code, 0);
+  EXPECT_NE(run_cli("remesh " + quoted_data_path("spot.obj") + " " + shell_quote(out.string()) + " --target-vertices 2")
+                .exit_code,
             0);
-  EXPECT_NE(run_cli("remesh " + data("spot.obj") + " " + shell_quote(out.string()) + " --edge-length -1").exit_code, 0);
+  EXPECT_NE(run_cli("remesh " + quoted_data_path("spot.obj") + " " + shell_quote(out.string()) + " --edge-length -1")
+                .exit_code,
+            0);
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 
@@ -127,7 +130,7 @@ TEST(CliEnhanceUnsharp, WritesTheMeshAndTheSameReport) {
   const auto report = dir.file("report.json");
   const auto pins = dir.file("pins.txt");
   { std::ofstream(pins) << "3 77\n"; }
-  const auto r = run_cli("enhance " + data("max-planck-5k.obj") + " " + shell_quote(out.string()) +
+  const auto r = run_cli("enhance " + quoted_data_path("max-planck-5k.obj") + " " + shell_quote(out.string()) +
                          " --method unsharp --weight 0.5 --pin " + shell_quote(pins.string()) + " --report " +
                          shell_quote(report.string()));
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -151,8 +154,9 @@ TEST(CliEnhanceUnsharp, WritesTheMeshAndTheSameReport) {
 
   // The default method is recorded as the flow.
   const auto flow_report = dir.file("flow.json");
-  const auto flow = run_cli("--quiet enhance " + data("spot.obj") + " " + shell_quote(dir.file("spot.ply").string()) +
-                            " --report " + shell_quote(flow_report.string()));
+  const auto flow =
+      run_cli("--quiet enhance " + quoted_data_path("spot.obj") + " " + shell_quote(dir.file("spot.ply").string()) +
+              " --report " + shell_quote(flow_report.string()));
   ASSERT_EQ(flow.exit_code, 0) << flow.err;
   EXPECT_EQ(nlohmann::json::parse(test::read_text(flow_report))["method"], "flow");
 }
@@ -160,15 +164,17 @@ TEST(CliEnhanceUnsharp, WritesTheMeshAndTheSameReport) {
 TEST(CliEnhanceUnsharp, OptionsOfTheOtherMethodAreRefused) {
   test::ScratchDir dir("cli-enhance-unsharp-bad");
   const auto out = dir.file("out.ply");
-  expect_one_line_error(run_cli("enhance " + data("spot.obj") + " " + shell_quote(out.string()) + " --weight 0.5"),
-                        "--weight and --smoothing-iterations apply to --method unsharp only");
   expect_one_line_error(
-      run_cli("enhance " + data("spot.obj") + " " + shell_quote(out.string()) + " --method unsharp --lambda 2"),
-      "--lambda applies to --method flow only");
+      run_cli("enhance " + quoted_data_path("spot.obj") + " " + shell_quote(out.string()) + " --weight 0.5"),
+      "--weight and --smoothing-iterations apply to --method unsharp only");
+  expect_one_line_error(run_cli("enhance " + quoted_data_path("spot.obj") + " " + shell_quote(out.string()) +
+                                " --method unsharp --lambda 2"),
+                        "--lambda applies to --method flow only");
   expect_one_line_error(run_cli("--quiet enhance " + shell_quote(write_bowtie(dir).string()) + " " +
                                 shell_quote(out.string()) + " --method unsharp"),
                         "bowtie.obj: unsharp mask: the mesh is not manifold");
-  EXPECT_NE(run_cli("enhance " + data("spot.obj") + " " + shell_quote(out.string()) + " --method laplace").exit_code,
+  EXPECT_NE(run_cli("enhance " + quoted_data_path("spot.obj") + " " + shell_quote(out.string()) + " --method laplace")
+                .exit_code,
             0);
   EXPECT_FALSE(std::filesystem::exists(out));
 }

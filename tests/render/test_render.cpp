@@ -469,7 +469,7 @@ TEST(RenderCli, DisplacementAgainstTheMeshBefore) {
 
 TEST(RenderCli, BadArgumentsGiveOneLineErrors) {
   test::ScratchDir dir("render_cli_bad");
-  const std::string in = test::shell_quote(test::data_path("sphere_low.off").string());
+  const std::string in = test::quoted_data_path("sphere_low.off");
   const auto run = [&](const std::string& args) { return test::run_cli("render " + in + " " + args); };
   for (const std::string& args :
        {test::shell_quote(dir.file("a.jpg").string()), test::shell_quote(dir.file("a.png").string()) + " --size 12",

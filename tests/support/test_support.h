@@ -51,6 +51,11 @@ CommandResult run_cli(const std::string& arguments);
 /// Single-quotes a string for /bin/sh.
 std::string shell_quote(const std::string& s);
 
+/// data_path(name), single-quoted for /bin/sh: a bundled mesh as a CLI argument.
+inline std::string quoted_data_path(const std::string& name) {
+  return shell_quote(data_path(name).string());
+}
+
 /// Expects `output` to be manifold and oriented with the same genus, components and boundary
 /// loops as `input` (gtest assertions).
 void expect_same_topology(const Mesh& input, const Mesh& output);
