@@ -153,6 +153,14 @@ struct Terms {
     return {ring.data() + ring_start[static_cast<std::size_t>(i)],
             ring.data() + ring_start[static_cast<std::size_t>(i) + 1]};
   }
+  /// Calls visit(j) for i and then each vertex of its one-ring: the vertices whose rows of
+  /// G and L involve i.
+  template <class Visit>
+  void for_each_in_star(Index i, Visit&& visit) const {
+    visit(i);
+    const auto [begin, end] = one_ring(i);
+    for (const Index* j = begin; j != end; ++j) visit(*j);
+  }
 };
 
 // Vertices sorted by the Morton code of their position (21 bits per axis), ties by index.
@@ -405,9 +413,7 @@ Matrix3 diagonal_block(const Terms& t, Index u) {
     block.noalias() += g * t.P[static_cast<std::size_t>(i)].full() * g;
     laplacian += t.smooth[static_cast<std::size_t>(i)] * l_entry(t, i, u) * l_entry(t, i, u);
   };
-  add(u);
-  const auto [begin, end] = t.one_ring(u);
-  for (const Index* i = begin; i != end; ++i) add(*i);
+  t.for_each_in_star(u, add);
   block.diagonal().array() += laplacian;
   return block;
 }
@@ -558,14 +564,7 @@ void FlowSystemSolver::Impl::build_pattern(const Terms& t) {
       mark[static_cast<std::size_t>(w)] = a;
       row.push_back(b);
     };
-    auto visit_star = [&](Index i) {
-      visit(i);
-      const auto [begin, end] = t.one_ring(i);
-      for (const Index* j = begin; j != end; ++j) visit(*j);
-    };
-    visit_star(u);
-    const auto [begin, end] = t.one_ring(u);
-    for (const Index* i = begin; i != end; ++i) visit_star(*i);
+    t.for_each_in_star(u, [&](Index i) { t.for_each_in_star(i, visit); });
     std::sort(row.begin(), row.end());
   });
   row_start.assign(static_cast<std::size_t>(m) + 1, 0);
@@ -650,13 +649,9 @@ cholmod_sparse* FlowSystemSolver::Impl::assemble(const Terms& t) {
         block.noalias() += left * g_block(t, i, w);
         block.diagonal().array() += l_u * l_entry(t, i, w);
       };
-      add(i);
-      const auto [begin, end] = t.one_ring(i);
-      for (const Index* j = begin; j != end; ++j) add(*j);
+      t.for_each_in_star(i, add);
     };
-    add_star(u);
-    const auto [begin, end] = t.one_ring(u);
-    for (const Index* i = begin; i != end; ++i) add_star(*i);
+    t.for_each_in_star(u, add_star);
     blocks.back() += t.D[static_cast<std::size_t>(u)].full();
     for (auto k = first; k < last; ++k)
       position[static_cast<std::size_t>(
