@@ -584,7 +584,7 @@ Curvature principal_curvatures(const Vertices& V, const Faces& F, const Topology
       kuv += t.kuv;
       kv += t.kv;
       if (left_out[static_cast<std::size_t>(*f)] & (1 << k))
-        weight -= face_geometry(V, F, *f, options.normal_weighting).area[k];
+        weight -= face_geometry(V, F, *f, NormalWeighting::Area).area[k];  // areas do not depend on it
     }
     if (!(weight > 0)) return Tensor{0, 0, 0};
     const double inverse = 1.0 / weight;
