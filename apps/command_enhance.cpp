@@ -210,12 +210,13 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
                            {"projection", r.seconds_projection},
                            {"guard", r.seconds_guard},
                            {"write", seconds_write}};
-      report["solver"] = {
-          {"relative_residual", r.solver_error},
-          {"d", r.d},
-          {"mean_edge_length", r.mean_edge_length},
-          {"method", r.solver_used == LinearSolver::Direct ? "direct (CHOLMOD)" : "conjugate gradients"},
-          {"iterations", r.solver_iterations}};
+      report["solver"] = {{"relative_residual", r.solver_error},
+                          {"d", r.d},
+                          {"mean_edge_length", r.mean_edge_length},
+                          {"method", r.solver_used == LinearSolver::Direct       ? "direct (CHOLMOD)"
+                                     : r.solver_used == LinearSolver::Multilevel ? "conjugate gradients, multilevel"
+                                                                                 : "conjugate gradients"},
+                          {"iterations", r.solver_iterations}};
       report["guard"] = {{"faces_bad_before_guard", r.flipped_before_guard},
                          {"faces_low_quality_before_guard", r.low_quality_before_guard},
                          {"limited_vertices", r.limited_vertices},

@@ -8,8 +8,9 @@
 //   build/bin/bench_flow --benchmark_filter='1M' --benchmark_repetitions=5   # own process: peak RSS
 //
 // "pipeline_ms" is curvature + assembly + factorisation + solve, the part the targets
-// are about (no I/O, no projection, no guard). Cases named .../direct and .../iterative force
-// the solver, to compare the two paths; the others use LinearSolver::Automatic.
+// are about (no I/O, no projection, no guard). Cases named .../direct, .../iterative and
+// .../multilevel force the solver, to compare the paths; the others use
+// LinearSolver::Automatic.
 #include "bench_support.h"
 
 #include "vertexflow/flow.h"
@@ -126,6 +127,7 @@ void run(benchmark::State& state, const std::string& name, LinearSolver solver) 
       (sum.seconds_curvature + sum.seconds_assembly + sum.seconds_factorization + sum.seconds_solve) * per_run_ms;
   state.counters["process_cpu_ms"] = cpu * per_run_ms;
   state.counters["direct"] = sum.solver_used == LinearSolver::Direct ? 1 : 0;
+  state.counters["multilevel"] = sum.solver_used == LinearSolver::Multilevel ? 1 : 0;
   state.counters["cg_iterations"] = sum.solver_iterations;
   state.counters["residual"] = sum.solver_error;
   state.counters["peak_rss_MB"] = peak_rss_megabytes();
@@ -145,8 +147,10 @@ void register_cases() {
     automatic->Unit(benchmark::kMillisecond)->UseRealTime();
     if (large) automatic->Iterations(1);
     if (name == "armadillo-1M") continue;  // the coupled factorisation does not fit (16 GB)
-    for (const LinearSolver forced : {LinearSolver::Direct, LinearSolver::Iterative}) {
-      const std::string suffix = forced == LinearSolver::Direct ? "/direct" : "/iterative";
+    for (const LinearSolver forced : {LinearSolver::Direct, LinearSolver::Iterative, LinearSolver::Multilevel}) {
+      const std::string suffix = forced == LinearSolver::Direct      ? "/direct"
+                                 : forced == LinearSolver::Iterative ? "/iterative"
+                                                                     : "/multilevel";
       auto* b = benchmark::RegisterBenchmark(("flow/" + name + suffix).c_str(),
                                              [name, forced](benchmark::State& state) { run(state, name, forced); });
       b->Unit(benchmark::kMillisecond)->UseRealTime();

@@ -1,4 +1,4 @@
-// Solves the flow's normal equations H d = b (flow_solver.h) by one of two methods.
+// Solves the flow's normal equations H d = b (flow_solver.h) by one of three methods.
 //
 // H = A^T A of flow_energy.h's rows is a sum of one-ring products. With K_i the curvature
 // tensor, G the 3n x 3n block operator (G x)_i = sum_{j in N(i)} (K_i + K_j)(x_i - x_j) (the g_i
@@ -17,6 +17,9 @@
 // - Iterative: conjugate gradients on the matrix-free H, started from the input (d = 0),
 //   preconditioned by the inverses of H's 3x3 diagonal blocks, which capture each vertex's
 //   anisotropy (stiff along the normal, soft in the tangent plane) exactly.
+// - Multilevel: the same iteration with a coarse space added to the preconditioner
+//   (MultilevelCorrection below, multigrid.h): smoothed aggregates of one-rings whose Galerkin
+//   matrix is coarsened again. It is for the smooth tangential modes of large flat regions.
 //
 // Why these two and how the choice is made (measured on this project's meshes, docs/benchmarks.md):
 // the coupled factorisation costs about n^1.5 (3.1e9 flops at 9k vertices, 1.8e10 at 43k, an
@@ -26,14 +29,18 @@
 // tangential motion to the bi-Laplacian of F_smo and the tiny pull (fandisk). Preconditioners
 // built on decoupled n x n factorisations (x, y, z, or per-vertex frames) and their two-level
 // combinations with Gauss-Seidel cost a factorisation each and still took 50-200 iterations,
-// so they lost to one of the two above everywhere.
+// so they lost to the two above everywhere; the aggregation coarse space needs no
+// factorisation of the fine problem and cuts fandisk from 930 to 129 iterations.
 // The automatic rule is therefore competitive: below kDirectBelow free vertices factor
-// directly; otherwise iterate, and if the iteration has not converged after about the number
+// directly; otherwise iterate (with the multilevel preconditioner where a large flat region
+// predicts slow modes, kFlatRegionForMultilevel), and if the iteration has not converged after about the number
 // of iterations that the factorisation would take to run (kBudgetPerSqrtVertex * sqrt(free
 // vertices), calibrated on this machine) fall back to the factorisation when its predicted
 // memory fits, so the total is at most about twice the better of the two. It depends only on
 // counts, so the output bytes do not depend on timings or thread counts.
 #include "flow_solver.h"
+
+#include "multigrid.h"
 
 #include "vertexflow/timing.h"
 
@@ -48,8 +55,12 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <memory>
 #include <numeric>
+#include <span>
 #include <stdexcept>
 
 namespace vertexflow {
@@ -84,6 +95,15 @@ constexpr Index kDirectBelow = 1000;
 // one iteration's time, both measured on bunny_uniform, armadillo-43k and amo (time ~ 4.5e-7
 // n^1.5 s against ~2.5e-8 n s on 2 cores, so the ratio is about 18 sqrt(n)).
 constexpr double kBudgetPerSqrtVertex = 18.0;
+// LinearSolver::Automatic takes the multilevel preconditioner when a connected region of at
+// least kFlatRegionForMultilevel free vertices has |k1| + |k2| < kFlatCurvature (per mean edge
+// length): there F_em vanishes and block-Jacobi's iteration count grows like the region's
+// diameter squared. Measured (largest such region; block-Jacobi against multilevel
+// iterations): fandisk 1,257 vertices, 930 against 129; amo 4,825, 291 against 93; every other
+// data mesh at most 105 vertices, where the set-up costs more than the iterations it saves
+// (bunny_uniform 79 against 57, horse-10k 98 against 53, each multilevel iteration ~1.3x).
+constexpr double kFlatCurvature = 0.01;
+constexpr Index kFlatRegionForMultilevel = 500;
 // Without a fallback (the factorisation would not fit) the iteration stops at this many
 // times the budget.
 constexpr int kIterationCapFactor = 10;
@@ -418,6 +438,242 @@ Matrix3 diagonal_block(const Terms& t, Index u) {
   return block;
 }
 
+// The size of the largest connected region of free vertices with |k1| + |k2| < kFlatCurvature.
+Index largest_flat_region(const Terms& t) {
+  const auto n = static_cast<std::size_t>(t.n);
+  std::vector<char> open(n, 0);  // flat and not yet visited
+  for (std::size_t i = 0; i < n; ++i) {
+    const Sym3& k = t.K[i];  // trace(K) = |k1| + |k2|
+    open[i] = !t.fixed[i] && k.xx + k.yy + k.zz < kFlatCurvature;
+  }
+  Index largest = 0;
+  std::vector<Index> queue;
+  for (Index seed = 0; seed < t.n; ++seed) {
+    if (!open[static_cast<std::size_t>(seed)]) continue;
+    open[static_cast<std::size_t>(seed)] = 0;
+    queue.assign(1, seed);
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+      const auto [begin, end] = t.one_ring(queue[head]);
+      for (const Index* j = begin; j != end; ++j)
+        if (open[static_cast<std::size_t>(*j)]) {
+          open[static_cast<std::size_t>(*j)] = 0;
+          queue.push_back(*j);
+        }
+    }
+    largest = std::max(largest, static_cast<Index>(queue.size()));
+  }
+  return largest;
+}
+
+// The fine level of LinearSolver::Multilevel's preconditioner: M = B + Phi M_c Phi^T, with B
+// the block-Jacobi inverse that the plain iteration uses, Phi the coarse space and M_c the
+// additive multilevel operator (multigrid.h) of the Galerkin matrix H_c = Phi^T H Phi.
+//
+// Why: block-Jacobi leaves the smooth modes to the iteration, and where F_em vanishes (flat
+// regions, K = 0) the only tangential stiffness is F_smo's bi-Laplacian, whose condition
+// number grows like the region's diameter to the fourth power: fandisk's flat faces took 930
+// iterations. Phi spans the translations of aggregates of one-rings, smoothed by one damped
+// Jacobi step of the uniform Laplacian so that neighbouring basis functions overlap (with
+// piecewise-constant ones the bi-Laplacian of a coarse function is large at aggregate borders).
+// The Galerkin matrix is summed vertex by vertex from H's factors (flow_solver.cpp's top
+// comment), not through H: H_c = (G Phi)^T P (G Phi) + (L Phi)^T S (L Phi) (x) I + Phi^T D Phi.
+class MultilevelCorrection {
+ public:
+  explicit MultilevelCorrection(const Terms& t) : t_(t) {
+    const auto n = static_cast<std::size_t>(t.n);
+    const std::vector<int> aggregate = aggregate_nodes(t.ring_start, t.ring, t.fixed, count_);
+    build_basis(aggregate);
+    // Per vertex i (the rows of A at i, fixed vertices included): for each aggregate a whose
+    // basis function is non-zero on the star of i, phi_a(i), the 3x3 block (G Phi_a)_i and the
+    // entry (L phi_a)_i.
+    std::vector<std::size_t> local_start(n + 1, 0);
+    for (std::size_t i = 0; i < n; ++i) {
+      std::size_t capacity = basis_size_[i];
+      const auto [begin, end] = t.one_ring(static_cast<Index>(i));
+      for (const Index* j = begin; j != end; ++j) capacity += basis_size_[static_cast<std::size_t>(*j)];
+      local_start[i + 1] = local_start[i] + capacity;
+    }
+    std::vector<Local> locals(local_start[n]);
+    std::vector<std::uint32_t> local_size(n, 0);
+    parallel_vertices(t.n, [&](Index i) {
+      const auto v = static_cast<std::size_t>(i);
+      Local* out = locals.data() + local_start[v];
+      std::uint32_t size = 0;
+      auto find = [&](Index a) -> Local& {
+        for (std::uint32_t k = 0; k < size; ++k)
+          if (out[k].aggregate == a) return out[k];
+        out[size] = Local{a, 0, Matrix3::Zero(), 0};
+        return out[size++];
+      };
+      const Matrix3 G = t.G[v].full(), K = t.K[v].full();
+      for (const Weight& w : basis(i)) {
+        Local& x = find(w.aggregate);
+        x.phi = w.value;
+        x.g += w.value * G;
+        x.l += w.value;
+      }
+      const auto [begin, end] = t.one_ring(i);
+      for (const Index* j = begin; j != end; ++j) {
+        const Matrix3 coupling = K + t.K[static_cast<std::size_t>(*j)].full();
+        for (const Weight& w : basis(*j)) {
+          Local& x = find(w.aggregate);
+          x.g -= w.value * coupling;
+          x.l -= t.inv_degree[v] * w.value;
+        }
+      }
+      std::sort(out, out + size, [](const Local& x, const Local& y) { return x.aggregate < y.aggregate; });
+      local_size[v] = size;
+    });
+    // The locals of each aggregate, by vertex (counting sort, so in vertex order).
+    const auto na = static_cast<std::size_t>(count_);
+    std::vector<std::size_t> touch_start(na + 1, 0);
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::size_t k = 0; k < local_size[i]; ++k)
+        ++touch_start[static_cast<std::size_t>(locals[local_start[i] + k].aggregate) + 1];
+    for (std::size_t a = 0; a < na; ++a) touch_start[a + 1] += touch_start[a];
+    std::vector<std::pair<Index, std::uint32_t>> touches(touch_start[na]);
+    {
+      std::vector<std::size_t> fill(touch_start.begin(), touch_start.end() - 1);
+      for (std::size_t i = 0; i < n; ++i)
+        for (std::uint32_t k = 0; k < local_size[i]; ++k)
+          touches[fill[static_cast<std::size_t>(locals[local_start[i] + k].aggregate)]++] = {static_cast<Index>(i), k};
+    }
+    // Row a of the upper half of H_c: blocks (a, b), b >= a, summed over the vertices in order.
+    std::vector<std::vector<std::pair<Index, Matrix3>>> rows(na);
+    tbb::enumerable_thread_specific<std::vector<Index>> positions([na] { return std::vector<Index>(na, -1); });
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, na, 64), [&](const tbb::blocked_range<std::size_t>& range) {
+      std::vector<Index>& position = positions.local();
+      for (std::size_t a = range.begin(); a != range.end(); ++a) {
+        auto& row = rows[a];
+        for (std::size_t m = touch_start[a]; m < touch_start[a + 1]; ++m) {
+          const auto [i, k] = touches[m];
+          const auto v = static_cast<std::size_t>(i);
+          const Local* local = locals.data() + local_start[v];
+          const Local& x = local[k];
+          const Matrix3 left = x.g * t.P[v].full();
+          const Matrix3 D = t.fixed[v] ? Matrix3::Zero().eval() : t.D[v].full();
+          for (std::uint32_t q = k; q < local_size[v]; ++q) {  // sorted, so local[q].aggregate >= a
+            const Local& y = local[q];
+            Index& p = position[static_cast<std::size_t>(y.aggregate)];
+            if (p < 0) {
+              p = static_cast<Index>(row.size());
+              row.emplace_back(y.aggregate, Matrix3::Zero());
+            }
+            Matrix3& block = row[static_cast<std::size_t>(p)].second;
+            block.noalias() += left * y.g;
+            block.diagonal().array() += t.smooth[v] * x.l * y.l;
+            block.noalias() += (x.phi * y.phi) * D;
+          }
+        }
+        for (const auto& entry : row) position[static_cast<std::size_t>(entry.first)] = -1;
+      }
+    });
+    std::vector<Eigen::Triplet<double>> triplets;
+    std::size_t blocks = 0;
+    for (const auto& row : rows) blocks += 2 * row.size();
+    triplets.reserve(9 * blocks);
+    for (std::size_t a = 0; a < na; ++a)
+      for (const auto& [b, block] : rows[a])
+        for (int r = 0; r < 3; ++r)
+          for (int c = 0; c < 3; ++c) {
+            const int row = 3 * static_cast<int>(a) + r, column = 3 * b + c;
+            triplets.emplace_back(row, column, block(r, c));
+            if (b != static_cast<Index>(a)) triplets.emplace_back(column, row, block(r, c));
+          }
+    AdditiveMultilevel::SparseMatrix coarse(3 * count_, 3 * count_);
+    coarse.setFromTriplets(triplets.begin(), triplets.end());
+    coarse_ = std::make_unique<AdditiveMultilevel>(std::move(coarse));
+    restricted_.resize(3 * count_);
+  }
+
+  [[nodiscard]] Index num_aggregates() const { return count_; }
+
+  // z += Phi M_c Phi^T r.
+  void add_to(const Vector& r, Vector& z) {
+    parallel_vertices(count_, [&](Index a) {
+      Vector3 sum = Vector3::Zero();
+      for (std::size_t k = member_start_[static_cast<std::size_t>(a)];
+           k < member_start_[static_cast<std::size_t>(a) + 1]; ++k)
+        sum += members_[k].value * at(r, members_[k].aggregate);  // .aggregate holds the vertex here
+      at(restricted_, a) = sum;
+    });
+    coarse_->apply(restricted_, coarse_solution_);
+    parallel_vertices(t_.n, [&](Index i) {
+      Vector3 sum = Vector3::Zero();
+      for (const Weight& w : basis(i)) sum += w.value * at(coarse_solution_, w.aggregate);
+      at(z, i) += sum;
+    });
+  }
+
+ private:
+  struct Weight {
+    Index aggregate;
+    double value;
+  };
+  struct Local {
+    Index aggregate;
+    double phi;  // phi_a(i)
+    Matrix3 g;   // (G Phi_a)_i
+    double l;    // (L phi_a)_i
+  };
+  static constexpr double kBasisSmoothing = 2.0 / 3.0;  // damping of the Jacobi step
+
+  std::span<const Weight> basis(Index i) const {
+    const auto v = static_cast<std::size_t>(i);
+    return {basis_.data() + basis_start_[v], basis_size_[v]};
+  }
+
+  // phi_a = (I - omega (I - W)) chi_a on free vertices, W the one-ring average, chi_a the
+  // indicator of aggregate a; stored per vertex (sorted by aggregate) and per aggregate.
+  void build_basis(const std::vector<int>& aggregate) {
+    const auto n = static_cast<std::size_t>(t_.n);
+    basis_start_.assign(n + 1, 0);
+    for (std::size_t i = 0; i < n; ++i)
+      basis_start_[i + 1] = basis_start_[i] + 1 + static_cast<std::size_t>(t_.ring_start[i + 1] - t_.ring_start[i]);
+    basis_.resize(basis_start_[n]);
+    basis_size_.assign(n, 0);
+    parallel_vertices(t_.n, [&](Index i) {
+      const auto v = static_cast<std::size_t>(i);
+      if (t_.fixed[v]) return;
+      Weight* out = basis_.data() + basis_start_[v];
+      std::size_t size = 0;
+      auto add = [&](Index a, double value) {
+        for (std::size_t k = 0; k < size; ++k)
+          if (out[k].aggregate == a) {
+            out[k].value += value;
+            return;
+          }
+        out[size++] = {a, value};
+      };
+      add(aggregate[v], 1 - kBasisSmoothing);
+      const auto [begin, end] = t_.one_ring(i);
+      const double w = kBasisSmoothing * t_.inv_degree[v];
+      for (const Index* j = begin; j != end; ++j)
+        if (aggregate[static_cast<std::size_t>(*j)] >= 0) add(aggregate[static_cast<std::size_t>(*j)], w);
+      std::sort(out, out + size, [](const Weight& x, const Weight& y) { return x.aggregate < y.aggregate; });
+      basis_size_[v] = size;
+    });
+    const auto na = static_cast<std::size_t>(count_);
+    member_start_.assign(na + 1, 0);
+    for (std::size_t i = 0; i < n; ++i)
+      for (const Weight& w : basis(static_cast<Index>(i))) ++member_start_[static_cast<std::size_t>(w.aggregate) + 1];
+    for (std::size_t a = 0; a < na; ++a) member_start_[a + 1] += member_start_[a];
+    members_.resize(member_start_[na]);
+    std::vector<std::size_t> fill(member_start_.begin(), member_start_.end() - 1);
+    for (std::size_t i = 0; i < n; ++i)
+      for (const Weight& w : basis(static_cast<Index>(i)))
+        members_[fill[static_cast<std::size_t>(w.aggregate)]++] = {static_cast<Index>(i), w.value};
+  }
+
+  const Terms& t_;
+  int count_ = 0;
+  std::vector<std::size_t> basis_start_, basis_size_, member_start_;
+  std::vector<Weight> basis_;    // per vertex: (aggregate, phi_a(i))
+  std::vector<Weight> members_;  // per aggregate: (vertex, phi_a(i))
+  std::unique_ptr<AdditiveMultilevel> coarse_;
+  Vector restricted_, coarse_solution_;
+};
+
 struct IterationResult {
   int iterations = 0;
   bool converged = false;
@@ -429,7 +685,8 @@ struct IterationResult {
 // Operator).
 class ConjugateGradients {
  public:
-  ConjugateGradients(const Terms& terms, Operator& op, const Vector& b) : t_(terms), op_(op) {
+  ConjugateGradients(const Terms& terms, Operator& op, const Vector& b, MultilevelCorrection* multilevel)
+      : t_(terms), op_(op), multilevel_(multilevel) {
     inverse_.resize(static_cast<std::size_t>(t_.n));
     parallel_vertices(t_.n, [&](Index u) {
       const auto v = static_cast<std::size_t>(u);
@@ -443,6 +700,10 @@ class ConjugateGradients {
       at(z_, i) = inverse_[static_cast<std::size_t>(i)] * at(r_, i);
       return at(r_, i).dot(at(z_, i));
     });
+    if (multilevel_) {
+      multilevel_->add_to(r_, z_);
+      rz_ = dot(r_, z_);
+    }
     p_ = z_;
     b_norm_ = std::sqrt(dot(b, b));
     r_norm_ = b_norm_;
@@ -469,7 +730,11 @@ class ConjugateGradients {
         return Eigen::Vector2d(r.squaredNorm(), r.dot(z));
       });
       r_norm_ = std::sqrt(sums[0]);
-      const double rz = sums[1];
+      double rz = sums[1];
+      if (multilevel_) {
+        multilevel_->add_to(r_, z_);
+        rz = dot(r_, z_);
+      }
       ++result.iterations;
       ++total_iterations_;
       if (r_norm_ <= target) {
@@ -489,7 +754,8 @@ class ConjugateGradients {
  private:
   const Terms& t_;
   Operator& op_;
-  std::vector<Sym3> inverse_;  // of H's diagonal blocks; zero at fixed vertices
+  MultilevelCorrection* multilevel_;  // null: block-Jacobi alone
+  std::vector<Sym3> inverse_;         // of H's diagonal blocks; zero at fixed vertices
   Vector d_, r_, z_, p_, hp_;
   double rz_ = 0, b_norm_ = 0, r_norm_ = 0;
   int total_iterations_ = 0;
@@ -739,15 +1005,26 @@ Vertices FlowSystemSolver::solve(const FlowFrame& frame, const EnergyWeights& we
 
   bool direct = s.kind == LinearSolver::Direct || (s.kind == LinearSolver::Automatic && m <= kDirectBelow);
   Vector d;
+  LinearSolver used = LinearSolver::Direct;
   report.solver_iterations = 0;
   if (!direct && m > 0) {
     start = Clock::now();
-    ConjugateGradients cg(terms, op, b);
+    std::unique_ptr<MultilevelCorrection> multilevel;
+    if (s.kind == LinearSolver::Multilevel ||
+        (s.kind == LinearSolver::Automatic && largest_flat_region(terms) >= kFlatRegionForMultilevel)) {
+      try {
+        multilevel = std::make_unique<MultilevelCorrection>(terms);
+      } catch (const std::runtime_error&) {
+        // The coarsest matrix lost definiteness to rounding (degenerate input): block-Jacobi
+        // alone still converges, only more slowly.
+      }
+    }
+    ConjugateGradients cg(terms, op, b, multilevel.get());
     report.seconds_factorization += seconds_since(start);
     start = Clock::now();
     const int budget = static_cast<int>(std::ceil(kBudgetPerSqrtVertex * std::sqrt(static_cast<double>(m))));
     IterationResult result =
-        cg.run(s.kind == LinearSolver::Iterative ? kIterationCapFactor * budget : budget, s.tolerance);
+        cg.run(s.kind == LinearSolver::Automatic ? budget : kIterationCapFactor * budget, s.tolerance);
     if (!result.converged && s.kind == LinearSolver::Automatic) {
       // Fall back to the factorisation if it fits; otherwise keep iterating.
       report.seconds_solve += seconds_since(start);
@@ -764,10 +1041,11 @@ Vertices FlowSystemSolver::solve(const FlowFrame& frame, const EnergyWeights& we
     report.seconds_solve += seconds_since(start);
     report.solver_iterations = cg.total_iterations();
     if (!direct) d = cg.solution();
+    used = direct ? LinearSolver::Direct : multilevel ? LinearSolver::Multilevel : LinearSolver::Iterative;
   }
   if (direct && m > 0) d = s.factor_and_solve(terms, b, report);
   if (m == 0) d = Vector::Zero(b.size());
-  report.solver_used = direct ? LinearSolver::Direct : LinearSolver::Iterative;
+  report.solver_used = direct ? LinearSolver::Direct : used;
 
   // The relative residual of the normal equations, independent of the method.
   start = Clock::now();

@@ -1,0 +1,61 @@
+// Internal to the flow stage: an additive multilevel preconditioner built by smoothed
+// aggregation, for symmetric positive definite matrices whose unknowns come in threes (x, y, z
+// of one node). flow_solver.cpp uses it on the coarse problem of its multilevel conjugate
+// gradients.
+//
+// Written here because no Debian package offers algebraic multigrid outside MPI stacks
+// (hypre, PETSc, Trilinos), and AMGCL, the header-only reference for the method, is not
+// packaged. The hierarchy is Vanek, Mandel and Brezina's smoothed aggregation (Computing 56,
+// 1996): aggregates of strongly coupled nodes, the three translations as near null space, the
+// tentative prolongator smoothed by one damped block-Jacobi step, Galerkin coarse matrices and
+// a dense factorisation on the coarsest level. The levels are combined additively (BPX
+// style, block-Jacobi on each level) rather than in a V-cycle: measured on fandisk's coarse
+// problem, a Gauss-Seidel V-cycle took 20% fewer outer iterations but each cost 1.5x more,
+// since the sweeps are sequential.
+#pragma once
+
+#include <Eigen/Dense>
+#include <Eigen/Sparse>
+
+#include <vector>
+
+namespace vertexflow {
+
+/// Greedy aggregation of a graph (Vanek et al.'s three phases): a node whose neighbours are all
+/// free of aggregates starts one with them; the remaining nodes join the aggregate of a
+/// nearest aggregated node (breadth first); nodes that still have none start aggregates of
+/// their connected remainder. `excluded` nodes get -1. Deterministic: nodes are visited in
+/// index order. The graph is CSR: node k's neighbours are neighbours[start[k] .. start[k+1]).
+/// Returns the aggregate of every node; `count` receives the number of aggregates.
+std::vector<int> aggregate_nodes(const std::vector<int>& start, const std::vector<int>& neighbours,
+                                 const std::vector<char>& excluded, int& count);
+
+/// The additive multilevel operator M = B_0 + P_1 (B_1 + P_2 (... + A_L^-1 ...) P_2^T) P_1^T,
+/// with B_l the inverses of level l's 3x3 diagonal blocks and A_L the coarsest Galerkin matrix,
+/// factored densely. M is symmetric positive definite, so it can precondition conjugate
+/// gradients. A: unknown 3k + c is coordinate c of node k.
+class AdditiveMultilevel {
+ public:
+  using SparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+
+  /// Coarsens until at most `coarsest_unknowns` remain or coarsening stalls.
+  explicit AdditiveMultilevel(SparseMatrix A, Eigen::Index coarsest_unknowns = 240);
+
+  /// x = M b.
+  void apply(const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
+
+  [[nodiscard]] int num_levels() const { return static_cast<int>(levels_.size()) + 1; }
+  [[nodiscard]] Eigen::Index coarsest_unknowns() const { return coarsest_factor_.rows(); }
+
+ private:
+  struct Level {
+    SparseMatrix block_inverse;  // B_l
+    SparseMatrix P, R;           // prolongation from the next level, and P^T
+  };
+  void apply(std::size_t level, const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
+
+  std::vector<Level> levels_;
+  Eigen::LLT<Eigen::MatrixXd> coarsest_factor_;
+};
+
+}  // namespace vertexflow
