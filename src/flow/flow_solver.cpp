@@ -568,40 +568,55 @@ class MultilevelCorrection {
         for (const auto& entry : row) position[static_cast<std::size_t>(entry.first)] = -1;
       }
     });
-    std::vector<Eigen::Triplet<double>> triplets;
-    std::size_t blocks = 0;
-    for (const auto& row : rows) blocks += 2 * row.size();
-    triplets.reserve(9 * blocks);
+    // Both halves, rows sorted by column.
+    std::vector<std::vector<std::pair<Index, Matrix3>>> full(na);
     for (std::size_t a = 0; a < na; ++a)
-      for (const auto& [b, block] : rows[a])
-        for (int r = 0; r < 3; ++r)
-          for (int c = 0; c < 3; ++c) {
-            const int row = 3 * static_cast<int>(a) + r, column = 3 * b + c;
-            triplets.emplace_back(row, column, block(r, c));
-            if (b != static_cast<Index>(a)) triplets.emplace_back(column, row, block(r, c));
-          }
-    AdditiveMultilevel::SparseMatrix coarse(3 * count_, 3 * count_);
-    coarse.setFromTriplets(triplets.begin(), triplets.end());
+      for (const auto& [b, block] : rows[a]) {
+        full[a].emplace_back(b, block);
+        if (b != static_cast<Index>(a))
+          full[static_cast<std::size_t>(b)].emplace_back(static_cast<Index>(a), block.transpose());
+      }
+    BlockSparseMatrix coarse;
+    coarse.rows = coarse.cols = count_;
+    coarse.start.assign(na + 1, 0);
+    for (std::size_t a = 0; a < na; ++a) coarse.start[a + 1] = coarse.start[a] + static_cast<int>(full[a].size());
+    coarse.column.resize(static_cast<std::size_t>(coarse.start[na]));
+    coarse.block.resize(static_cast<std::size_t>(coarse.start[na]));
+    parallel_vertices(count_, [&](Index a) {
+      auto& row = full[static_cast<std::size_t>(a)];
+      std::sort(row.begin(), row.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+      auto m = static_cast<std::size_t>(coarse.start[static_cast<std::size_t>(a)]);
+      for (const auto& [b, block] : row) {
+        coarse.column[m] = b;
+        coarse.block[m++] = block;
+      }
+    });
     coarse_ = std::make_unique<AdditiveMultilevel>(std::move(coarse));
     restricted_.resize(3 * count_);
   }
 
   [[nodiscard]] Index num_aggregates() const { return count_; }
 
-  // z += Phi M_c Phi^T r.
-  void add_to(const Vector& r, Vector& z) {
-    parallel_vertices(count_, [&](Index a) {
+  // z += Phi M_c Phi^T r; returns r . z (summed in chunks, as every dot product here).
+  double add_to(const Vector& r, Vector& z) {
+    auto restrict_to = [&](Index a) {
       Vector3 sum = Vector3::Zero();
       for (std::size_t k = member_start_[static_cast<std::size_t>(a)];
            k < member_start_[static_cast<std::size_t>(a) + 1]; ++k)
         sum += members_[k].value * at(r, members_[k].aggregate);  // .aggregate holds the vertex here
       at(restricted_, a) = sum;
-    });
+    };
+    if (count_ < kSerialAggregatesBelow) {
+      for (Index a = 0; a < count_; ++a) restrict_to(a);
+    } else {
+      parallel_vertices(count_, restrict_to);
+    }
     coarse_->apply(restricted_, coarse_solution_);
-    parallel_vertices(t_.n, [&](Index i) {
+    return chunked_sum(t_.n, 0.0, [&](Index i) {
       Vector3 sum = Vector3::Zero();
       for (const Weight& w : basis(i)) sum += w.value * at(coarse_solution_, w.aggregate);
       at(z, i) += sum;
+      return at(r, i).dot(at(z, i));
     });
   }
 
@@ -617,6 +632,8 @@ class MultilevelCorrection {
     double l;    // (L phi_a)_i
   };
   static constexpr double kBasisSmoothing = 2.0 / 3.0;  // damping of the Jacobi step
+  // Restriction in the calling thread below this many aggregates (tasks cost more).
+  static constexpr Index kSerialAggregatesBelow = 2048;
 
   std::span<const Weight> basis(Index i) const {
     const auto v = static_cast<std::size_t>(i);
@@ -700,10 +717,7 @@ class ConjugateGradients {
       at(z_, i) = inverse_[static_cast<std::size_t>(i)] * at(r_, i);
       return at(r_, i).dot(at(z_, i));
     });
-    if (multilevel_) {
-      multilevel_->add_to(r_, z_);
-      rz_ = dot(r_, z_);
-    }
+    if (multilevel_) rz_ = multilevel_->add_to(r_, z_);
     p_ = z_;
     b_norm_ = std::sqrt(dot(b, b));
     r_norm_ = b_norm_;
@@ -731,10 +745,7 @@ class ConjugateGradients {
       });
       r_norm_ = std::sqrt(sums[0]);
       double rz = sums[1];
-      if (multilevel_) {
-        multilevel_->add_to(r_, z_);
-        rz = dot(r_, z_);
-      }
+      if (multilevel_) rz = multilevel_->add_to(r_, z_);
       ++result.iterations;
       ++total_iterations_;
       if (r_norm_ <= target) {

@@ -1,86 +1,163 @@
 #include "multigrid.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 #include <stdexcept>
+#include <utility>
 
 namespace vertexflow {
 namespace {
 
-using SparseMatrix = AdditiveMultilevel::SparseMatrix;
-using Triplet = Eigen::Triplet<double>;
+using Matrix3 = Eigen::Matrix3d;
+using Vector3 = Eigen::Vector3d;
 
 // Strength of connection between nodes (Vanek et al.): |A_kl|_F >= theta sqrt(|A_kk|_F |A_ll|_F).
 // Weak couplings would glue aggregates across the anisotropy and are left out of the graph.
 constexpr double kStrengthThreshold = 0.08;
-// Power iterations for the spectral radius of D^-1 A in the prolongator's damping.
+// Power iterations for the spectral radius of B A in the prolongator's damping.
 constexpr int kPowerIterations = 12;
 
-// The strong-connection graph of A's 3x3 blocks, CSR.
-void strength_graph(const SparseMatrix& A, std::vector<int>& start, std::vector<int>& neighbours) {
-  const auto nodes = static_cast<int>(A.rows() / 3);
-  // |A_kl|_F^2 of every stored block, row by row with a dense accumulator.
-  std::vector<double> squared(static_cast<std::size_t>(nodes), 0.0), diagonal(static_cast<std::size_t>(nodes), 0.0);
-  std::vector<int> touched;
-  std::vector<std::vector<std::pair<int, double>>> blocks(static_cast<std::size_t>(nodes));
-  for (int k = 0; k < nodes; ++k) {
-    touched.clear();
-    for (int c = 0; c < 3; ++c)
-      for (SparseMatrix::InnerIterator it(A, 3 * k + c); it; ++it) {
-        const auto l = static_cast<int>(it.col() / 3);
-        if (squared[static_cast<std::size_t>(l)] == 0) touched.push_back(l);
-        squared[static_cast<std::size_t>(l)] += it.value() * it.value() + 1e-300;  // touched, even if zero
-      }
-    auto& row = blocks[static_cast<std::size_t>(k)];
-    row.reserve(touched.size());
-    for (const int l : touched) {
-      row.emplace_back(l, squared[static_cast<std::size_t>(l)]);
-      squared[static_cast<std::size_t>(l)] = 0;
-    }
-    std::sort(row.begin(), row.end());
-    for (const auto& [l, value] : row)
-      if (l == k) diagonal[static_cast<std::size_t>(k)] = std::sqrt(value);
+// Rows in parallel, or in the calling thread when there are few: the coarse levels are applied
+// once per outer iteration, and for a few hundred rows starting tasks cost more than the rows.
+constexpr int kSerialBelow = 2048;
+
+template <class Body>
+void parallel_rows(int rows, Body&& body) {
+  if (rows < kSerialBelow) {
+    for (int k = 0; k < rows; ++k) body(k);
+    return;
   }
-  start.assign(static_cast<std::size_t>(nodes) + 1, 0);
+  tbb::parallel_for(tbb::blocked_range<int>(0, rows, 128), [&](const tbb::blocked_range<int>& range) {
+    for (int k = range.begin(); k != range.end(); ++k) body(k);
+  });
+}
+
+Eigen::Map<const Vector3> at(const Eigen::VectorXd& v, int k) {
+  return Eigen::Map<const Vector3>(v.data() + 3 * k);
+}
+Eigen::Map<Vector3> at(Eigen::VectorXd& v, int k) {
+  return Eigen::Map<Vector3>(v.data() + 3 * k);
+}
+
+// The blocks of one output row, keyed by column (a sparse accumulator).
+class RowAccumulator {
+ public:
+  explicit RowAccumulator(int cols) : position_(static_cast<std::size_t>(cols), -1) {}
+  Matrix3& operator[](int column) {
+    int& p = position_[static_cast<std::size_t>(column)];
+    if (p < 0) {
+      p = static_cast<int>(entries_.size());
+      entries_.emplace_back(column, Matrix3::Zero());
+    }
+    return entries_[static_cast<std::size_t>(p)].second;
+  }
+  // Moves the row out, sorted by column, and clears the accumulator.
+  std::vector<std::pair<int, Matrix3>> take() {
+    for (const auto& entry : entries_) position_[static_cast<std::size_t>(entry.first)] = -1;
+    std::sort(entries_.begin(), entries_.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    return std::exchange(entries_, {});
+  }
+
+ private:
+  std::vector<int> position_;
+  std::vector<std::pair<int, Matrix3>> entries_;
+};
+
+// A rows x cols block matrix whose row k is body(k, accumulator), rows built in parallel (each
+// row's sums in the order body adds them, so the result does not depend on the threads).
+template <class Body>
+BlockSparseMatrix build_rows(int rows, int cols, Body&& body) {
+  std::vector<std::vector<std::pair<int, Matrix3>>> built(static_cast<std::size_t>(rows));
+  tbb::enumerable_thread_specific<RowAccumulator> accumulators([cols] { return RowAccumulator(cols); });
+  parallel_rows(rows, [&](int k) {
+    RowAccumulator& accumulator = accumulators.local();
+    body(k, accumulator);
+    built[static_cast<std::size_t>(k)] = accumulator.take();
+  });
+  BlockSparseMatrix A;
+  A.rows = rows;
+  A.cols = cols;
+  A.start.assign(static_cast<std::size_t>(rows) + 1, 0);
+  for (int k = 0; k < rows; ++k)
+    A.start[static_cast<std::size_t>(k) + 1] =
+        A.start[static_cast<std::size_t>(k)] + static_cast<int>(built[static_cast<std::size_t>(k)].size());
+  A.column.resize(static_cast<std::size_t>(A.start.back()));
+  A.block.resize(static_cast<std::size_t>(A.start.back()));
+  parallel_rows(rows, [&](int k) {
+    auto m = static_cast<std::size_t>(A.start[static_cast<std::size_t>(k)]);
+    for (const auto& [column, block] : built[static_cast<std::size_t>(k)]) {
+      A.column[m] = column;
+      A.block[m++] = block;
+    }
+  });
+  return A;
+}
+
+BlockSparseMatrix transpose(const BlockSparseMatrix& A) {
+  BlockSparseMatrix T;
+  T.rows = A.cols;
+  T.cols = A.rows;
+  T.start.assign(static_cast<std::size_t>(T.rows) + 1, 0);
+  for (const int c : A.column) ++T.start[static_cast<std::size_t>(c) + 1];
+  std::partial_sum(T.start.begin(), T.start.end(), T.start.begin());
+  T.column.resize(A.column.size());
+  T.block.resize(A.block.size());
+  std::vector<int> fill(T.start.begin(), T.start.end() - 1);
+  for (int k = 0; k < A.rows; ++k)  // rows in order, so each row of T is sorted
+    for (int m = A.start[static_cast<std::size_t>(k)]; m < A.start[static_cast<std::size_t>(k) + 1]; ++m) {
+      const auto out =
+          static_cast<std::size_t>(fill[static_cast<std::size_t>(A.column[static_cast<std::size_t>(m)])]++);
+      T.column[out] = k;
+      T.block[out] = A.block[static_cast<std::size_t>(m)].transpose();
+    }
+  return T;
+}
+
+// The strong-connection graph of A's blocks, CSR.
+void strength_graph(const BlockSparseMatrix& A, std::vector<int>& start, std::vector<int>& neighbours) {
+  std::vector<double> diagonal(static_cast<std::size_t>(A.rows), 0.0);
+  for (int k = 0; k < A.rows; ++k)
+    for (int m = A.start[static_cast<std::size_t>(k)]; m < A.start[static_cast<std::size_t>(k) + 1]; ++m)
+      if (A.column[static_cast<std::size_t>(m)] == k)
+        diagonal[static_cast<std::size_t>(k)] = A.block[static_cast<std::size_t>(m)].norm();
+  start.assign(static_cast<std::size_t>(A.rows) + 1, 0);
   neighbours.clear();
-  for (int k = 0; k < nodes; ++k) {
-    for (const auto& [l, value] : blocks[static_cast<std::size_t>(k)]) {
+  for (int k = 0; k < A.rows; ++k) {
+    for (int m = A.start[static_cast<std::size_t>(k)]; m < A.start[static_cast<std::size_t>(k) + 1]; ++m) {
+      const int l = A.column[static_cast<std::size_t>(m)];
       if (l == k) continue;
       const double bound = kStrengthThreshold * kStrengthThreshold * diagonal[static_cast<std::size_t>(k)] *
                            diagonal[static_cast<std::size_t>(l)];
-      if (value >= bound) neighbours.push_back(l);
+      if (A.block[static_cast<std::size_t>(m)].squaredNorm() >= bound) neighbours.push_back(l);
     }
     start[static_cast<std::size_t>(k) + 1] = static_cast<int>(neighbours.size());
   }
 }
 
-// The inverses of A's 3x3 diagonal blocks, as a block-diagonal matrix.
-SparseMatrix block_diagonal_inverse(const SparseMatrix& A) {
-  const Eigen::Index nodes = A.rows() / 3;
-  std::vector<Triplet> triplets;
-  triplets.reserve(static_cast<std::size_t>(9 * nodes));
-  for (Eigen::Index k = 0; k < nodes; ++k) {
-    Eigen::Matrix3d block = Eigen::Matrix3d::Zero();
-    for (int c = 0; c < 3; ++c)
-      for (SparseMatrix::InnerIterator it(A, 3 * k + c); it; ++it)
-        if (it.col() / 3 == k) block(c, it.col() % 3) = it.value();
-    const Eigen::Matrix3d inverse = block.inverse();
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) triplets.emplace_back(3 * k + r, 3 * k + c, inverse(r, c));
-  }
-  SparseMatrix D(A.rows(), A.cols());
-  D.setFromTriplets(triplets.begin(), triplets.end());
-  return D;
+std::vector<Matrix3> block_diagonal_inverse(const BlockSparseMatrix& A) {
+  std::vector<Matrix3> inverse(static_cast<std::size_t>(A.rows), Matrix3::Zero());
+  parallel_rows(A.rows, [&](int k) {
+    for (int m = A.start[static_cast<std::size_t>(k)]; m < A.start[static_cast<std::size_t>(k) + 1]; ++m)
+      if (A.column[static_cast<std::size_t>(m)] == k)
+        inverse[static_cast<std::size_t>(k)] = A.block[static_cast<std::size_t>(m)].inverse();
+  });
+  return inverse;
 }
 
-// Largest eigenvalue of D^-1 A (similar to a symmetric matrix), by power iteration from a
-// fixed start.
-double spectral_radius(const SparseMatrix& inverse_diagonal, const SparseMatrix& A) {
-  Eigen::VectorXd v(A.rows());
+// Largest eigenvalue of B A (similar to a symmetric matrix), by power iteration from a fixed
+// start.
+double spectral_radius(const std::vector<Matrix3>& inverse_diagonal, const BlockSparseMatrix& A) {
+  Eigen::VectorXd v(3 * static_cast<Eigen::Index>(A.rows)), w;
   for (Eigen::Index k = 0; k < v.size(); ++k) v[k] = 1.0 + 0.5 * std::sin(0.7 * static_cast<double>(k));
   double lambda = 1;
   for (int iteration = 0; iteration < kPowerIterations; ++iteration) {
-    Eigen::VectorXd w = inverse_diagonal * (A * v);
+    A.multiply(v, w);
+    for (int k = 0; k < A.rows; ++k) at(w, k) = inverse_diagonal[static_cast<std::size_t>(k)] * at(w, k);
     lambda = w.norm() / v.norm();
     v = w / w.norm();
   }
@@ -88,6 +165,16 @@ double spectral_radius(const SparseMatrix& inverse_diagonal, const SparseMatrix&
 }
 
 }  // namespace
+
+void BlockSparseMatrix::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
+  y.resize(3 * static_cast<Eigen::Index>(rows));
+  parallel_rows(rows, [&](int k) {
+    Vector3 sum = Vector3::Zero();
+    for (int m = start[static_cast<std::size_t>(k)]; m < start[static_cast<std::size_t>(k) + 1]; ++m)
+      sum.noalias() += block[static_cast<std::size_t>(m)] * at(x, column[static_cast<std::size_t>(m)]);
+    at(y, k) = sum;
+  });
+}
 
 std::vector<int> aggregate_nodes(const std::vector<int>& start, const std::vector<int>& neighbours,
                                  const std::vector<char>& excluded, int& count) {
@@ -140,44 +227,62 @@ std::vector<int> aggregate_nodes(const std::vector<int>& start, const std::vecto
   return aggregate;
 }
 
-AdditiveMultilevel::AdditiveMultilevel(SparseMatrix A, Eigen::Index coarsest_unknowns) {
-  if (A.rows() != A.cols() || A.rows() % 3 != 0)
-    throw std::invalid_argument("multilevel: the matrix must be square with 3 unknowns per node");
-  A.makeCompressed();
-  while (A.rows() > coarsest_unknowns) {
+AdditiveMultilevel::AdditiveMultilevel(BlockSparseMatrix A, int coarsest_unknowns) {
+  if (A.rows != A.cols || A.start.size() != static_cast<std::size_t>(A.rows) + 1)
+    throw std::invalid_argument("multilevel: the matrix must be square");
+  while (3 * A.rows > coarsest_unknowns) {
     std::vector<int> start, neighbours;
     strength_graph(A, start, neighbours);
-    const auto nodes = static_cast<int>(A.rows() / 3);
     int count = 0;
     const std::vector<int> aggregate =
-        aggregate_nodes(start, neighbours, std::vector<char>(static_cast<std::size_t>(nodes), 0), count);
-    if (count == 0 || 3 * count > 0.8 * static_cast<double>(A.rows())) break;  // coarsening stalled
+        aggregate_nodes(start, neighbours, std::vector<char>(static_cast<std::size_t>(A.rows), 0), count);
+    if (count == 0 || count > 0.8 * A.rows) break;  // coarsening stalled
     // Tentative prolongator: the translations of each aggregate, columns of unit length.
-    std::vector<int> size(static_cast<std::size_t>(count), 0);
-    for (const int a : aggregate) ++size[static_cast<std::size_t>(a)];
-    std::vector<Triplet> triplets;
-    triplets.reserve(static_cast<std::size_t>(A.rows()));
-    for (int k = 0; k < nodes; ++k) {
-      const int a = aggregate[static_cast<std::size_t>(k)];
-      const double scale = 1.0 / std::sqrt(static_cast<double>(size[static_cast<std::size_t>(a)]));
-      for (int c = 0; c < 3; ++c) triplets.emplace_back(3 * k + c, 3 * a + c, scale);
-    }
-    SparseMatrix tentative(A.rows(), 3 * static_cast<Eigen::Index>(count));
-    tentative.setFromTriplets(triplets.begin(), triplets.end());
+    std::vector<double> scale(static_cast<std::size_t>(count), 0.0);
+    for (const int a : aggregate) scale[static_cast<std::size_t>(a)] += 1;
+    for (double& s : scale) s = 1.0 / std::sqrt(s);
     // P = (I - omega B A) P_tent with omega = 4 / (3 rho(B A)), the usual damping (it
     // minimises the prolongator's energy for the highest modes).
     Level level;
     level.block_inverse = block_diagonal_inverse(A);
     const double omega = 4.0 / (3.0 * spectral_radius(level.block_inverse, A));
-    level.P = tentative - omega * SparseMatrix(level.block_inverse * SparseMatrix(A * tentative));
-    level.P.prune(0.0);
-    level.R = level.P.transpose();
-    SparseMatrix coarse = level.R * SparseMatrix(A * level.P);
+    level.P = build_rows(A.rows, count, [&](int k, RowAccumulator& row) {
+      const auto a = aggregate[static_cast<std::size_t>(k)];
+      row[a].diagonal().array() += scale[static_cast<std::size_t>(a)];
+      const Matrix3 damped = omega * level.block_inverse[static_cast<std::size_t>(k)];
+      for (int m = A.start[static_cast<std::size_t>(k)]; m < A.start[static_cast<std::size_t>(k) + 1]; ++m) {
+        const auto b = aggregate[static_cast<std::size_t>(A.column[static_cast<std::size_t>(m)])];
+        row[b].noalias() -= scale[static_cast<std::size_t>(b)] * (damped * A.block[static_cast<std::size_t>(m)]);
+      }
+    });
+    level.R = transpose(level.P);
+    // Galerkin: A_c = R (A P).
+    const BlockSparseMatrix AP = build_rows(A.rows, count, [&](int k, RowAccumulator& row) {
+      for (int m = A.start[static_cast<std::size_t>(k)]; m < A.start[static_cast<std::size_t>(k) + 1]; ++m) {
+        const int l = A.column[static_cast<std::size_t>(m)];
+        const Matrix3& a = A.block[static_cast<std::size_t>(m)];
+        for (int q = level.P.start[static_cast<std::size_t>(l)]; q < level.P.start[static_cast<std::size_t>(l) + 1];
+             ++q)
+          row[level.P.column[static_cast<std::size_t>(q)]].noalias() += a * level.P.block[static_cast<std::size_t>(q)];
+      }
+    });
+    BlockSparseMatrix coarse = build_rows(count, count, [&](int i, RowAccumulator& row) {
+      for (int m = level.R.start[static_cast<std::size_t>(i)]; m < level.R.start[static_cast<std::size_t>(i) + 1];
+           ++m) {
+        const int k = level.R.column[static_cast<std::size_t>(m)];
+        const Matrix3& r = level.R.block[static_cast<std::size_t>(m)];
+        for (int q = AP.start[static_cast<std::size_t>(k)]; q < AP.start[static_cast<std::size_t>(k) + 1]; ++q)
+          row[AP.column[static_cast<std::size_t>(q)]].noalias() += r * AP.block[static_cast<std::size_t>(q)];
+      }
+    });
     levels_.push_back(std::move(level));
     A = std::move(coarse);
-    A.makeCompressed();
   }
-  coarsest_factor_.compute(Eigen::MatrixXd(A));
+  Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(3 * A.rows, 3 * A.rows);
+  for (int k = 0; k < A.rows; ++k)
+    for (int m = A.start[static_cast<std::size_t>(k)]; m < A.start[static_cast<std::size_t>(k) + 1]; ++m)
+      dense.block<3, 3>(3 * k, 3 * A.column[static_cast<std::size_t>(m)]) = A.block[static_cast<std::size_t>(m)];
+  coarsest_factor_.compute(dense);
   if (coarsest_factor_.info() != Eigen::Success)
     throw std::runtime_error("multilevel: the coarsest matrix is not positive definite");
 }
@@ -192,10 +297,11 @@ void AdditiveMultilevel::apply(std::size_t index, const Eigen::VectorXd& b, Eige
     return;
   }
   const Level& level = levels_[index];
-  Eigen::VectorXd coarse;
-  apply(index + 1, level.R * b, coarse);
-  x = level.block_inverse * b;
-  x += level.P * coarse;
+  Eigen::VectorXd restricted, coarse;
+  level.R.multiply(b, restricted);
+  apply(index + 1, restricted, coarse);
+  level.P.multiply(coarse, x);
+  parallel_rows(level.P.rows, [&](int k) { at(x, k) += level.block_inverse[static_cast<std::size_t>(k)] * at(b, k); });
 }
 
 }  // namespace vertexflow

@@ -1,25 +1,36 @@
 // Internal to the flow stage: an additive multilevel preconditioner built by smoothed
-// aggregation, for symmetric positive definite matrices whose unknowns come in threes (x, y, z
-// of one node). flow_solver.cpp uses it on the coarse problem of its multilevel conjugate
-// gradients.
+// aggregation, for symmetric positive definite matrices of 3x3 blocks (x, y, z of one node).
+// flow_solver.cpp uses it on the coarse problem of LinearSolver::Multilevel.
 //
 // Written here because no Debian package offers algebraic multigrid outside MPI stacks
 // (hypre, PETSc, Trilinos), and AMGCL, the header-only reference for the method, is not
 // packaged. The hierarchy is Vanek, Mandel and Brezina's smoothed aggregation (Computing 56,
 // 1996): aggregates of strongly coupled nodes, the three translations as near null space, the
 // tentative prolongator smoothed by one damped block-Jacobi step, Galerkin coarse matrices and
-// a dense factorisation on the coarsest level. The levels are combined additively (BPX
-// style, block-Jacobi on each level) rather than in a V-cycle: measured on fandisk's coarse
-// problem, a Gauss-Seidel V-cycle took 20% fewer outer iterations but each cost 1.5x more,
-// since the sweeps are sequential.
+// a dense Cholesky factorisation on the coarsest level. The levels are combined additively
+// (BPX style, block-Jacobi on each level) rather than in a V-cycle: measured on fandisk's
+// coarse problem, a Gauss-Seidel V-cycle took 20% fewer outer iterations but each cost 1.5x
+// more, since its sweeps are sequential. The matrices are kept as 3x3 blocks throughout (not
+// Eigen's scalar sparse products, which took 4x longer to build the same hierarchy).
 #pragma once
 
 #include <Eigen/Dense>
-#include <Eigen/Sparse>
 
 #include <vector>
 
 namespace vertexflow {
+
+/// A square sparse matrix of 3x3 blocks in compressed rows: row k holds the blocks
+/// (k, column[m]) for m in [start[k], start[k+1]), columns increasing.
+struct BlockSparseMatrix {
+  int rows = 0, cols = 0;  // in blocks
+  std::vector<int> start{0};
+  std::vector<int> column;
+  std::vector<Eigen::Matrix3d> block;
+
+  /// y = A x (3 entries per block row / column).
+  void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
+};
 
 /// Greedy aggregation of a graph (Vanek et al.'s three phases): a node whose neighbours are all
 /// free of aggregates starts one with them; the remaining nodes join the aggregate of a
@@ -33,13 +44,13 @@ std::vector<int> aggregate_nodes(const std::vector<int>& start, const std::vecto
 /// The additive multilevel operator M = B_0 + P_1 (B_1 + P_2 (... + A_L^-1 ...) P_2^T) P_1^T,
 /// with B_l the inverses of level l's 3x3 diagonal blocks and A_L the coarsest Galerkin matrix,
 /// factored densely. M is symmetric positive definite, so it can precondition conjugate
-/// gradients. A: unknown 3k + c is coordinate c of node k.
+/// gradients. Deterministic, and the same for any thread count.
 class AdditiveMultilevel {
  public:
-  using SparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
-
-  /// Coarsens until at most `coarsest_unknowns` remain or coarsening stalls.
-  explicit AdditiveMultilevel(SparseMatrix A, Eigen::Index coarsest_unknowns = 240);
+  /// A: symmetric positive definite, both halves stored. Coarsens until at most
+  /// `coarsest_unknowns` unknowns remain or coarsening stalls. Throws std::runtime_error if the
+  /// coarsest matrix is not numerically positive definite.
+  explicit AdditiveMultilevel(BlockSparseMatrix A, int coarsest_unknowns = 240);
 
   /// x = M b.
   void apply(const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
@@ -49,8 +60,9 @@ class AdditiveMultilevel {
 
  private:
   struct Level {
-    SparseMatrix block_inverse;  // B_l
-    SparseMatrix P, R;           // prolongation from the next level, and P^T
+    std::vector<Eigen::Matrix3d> block_inverse;  // B_l
+    BlockSparseMatrix P;                         // prolongation from the next level
+    BlockSparseMatrix R;                         // P^T
   };
   void apply(std::size_t level, const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
 
