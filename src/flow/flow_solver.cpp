@@ -60,6 +60,7 @@
 #include <cstring>
 #include <memory>
 #include <numeric>
+#include <optional>
 #include <span>
 #include <stdexcept>
 
@@ -369,11 +370,28 @@ class Operator {
 
   // Returns x . y (summed in chunks).
   double apply(const Vector& x, Vector& y, bool with_d, bool with_rest) {
+    return passes(x, y, with_d, with_rest, [&](Index i) -> Vector3 { return at(x, i); });
+  }
+
+  // p = z + beta p, then y = H p; returns p . y. Conjugate gradients' direction update rides
+  // on the first pass instead of a pass (and a round of tasks) of its own.
+  double apply_updated(Vector& p, const Vector& z, double beta, Vector& y) {
+    return passes(p, y, true, false, [&](Index i) -> Vector3 {
+      const Vector3 updated = at(z, i) + beta * at(p, i);
+      at(p, i) = updated;
+      return updated;
+    });
+  }
+
+ private:
+  // first(i) gives x_i (and may write it) in the first pass; the later passes read x.
+  template <class First>
+  double passes(const Vector& x, Vector& y, bool with_d, bool with_rest, First&& first) {
     // What a vertex reads of its neighbours is interleaved in one record per vertex, so that a
     // neighbour costs one or two cache lines instead of one per array: the gathers' cache
     // misses were the hot spots of both one-ring passes.
     parallel_vertices(t_.n, [&](Index i) {
-      const Vector3 xi = at(x, i);
+      const Vector3 xi = first(i);
       record<6>(xkx_, i).head<3>() = xi;
       record<6>(xkx_, i).tail<3>() = t_.K[static_cast<std::size_t>(i)] * xi;
     });
@@ -411,7 +429,6 @@ class Operator {
     });
   }
 
- private:
   template <int Size>
   static Eigen::Map<Eigen::Matrix<double, Size, 1>> record(std::vector<double>& data, Index i) {
     return Eigen::Map<Eigen::Matrix<double, Size, 1>>(data.data() + Size * static_cast<std::size_t>(i));
@@ -731,7 +748,10 @@ class ConjugateGradients {
       return result;
     }
     while (result.iterations < max_iterations) {
-      const double curvature = op_.apply(p_, hp_, true, false);
+      // p = z + beta p is still to be done when a previous iteration computed beta.
+      const double curvature = pending_beta_ ? op_.apply_updated(p_, z_, *pending_beta_, hp_)
+                                             : op_.apply(p_, hp_, true, false);
+      pending_beta_.reset();
       if (!(curvature > 0)) break;  // H is positive definite; only rounding at convergence gets here
       const double alpha = rz_ / curvature;
       // d += alpha p, r -= alpha H p, z = M^-1 r; sums of r.r and r.z.
@@ -752,9 +772,8 @@ class ConjugateGradients {
         result.converged = true;
         break;
       }
-      const double beta = rz / rz_;
+      pending_beta_ = rz / rz_;
       rz_ = rz;
-      parallel_vertices(t_.n, [&](Index i) { at(p_, i) = at(z_, i) + beta * at(p_, i); });
     }
     return result;
   }
@@ -766,6 +785,7 @@ class ConjugateGradients {
   const Terms& t_;
   Operator& op_;
   MultilevelCorrection* multilevel_;  // null: block-Jacobi alone
+  std::optional<double> pending_beta_;  // p = z + beta p, done by the next operator application
   std::vector<Sym3> inverse_;         // of H's diagonal blocks; zero at fixed vertices
   Vector d_, r_, z_, p_, hp_;
   double rz_ = 0, b_norm_ = 0, r_norm_ = 0;
