@@ -74,10 +74,13 @@ template <class Body>
 BlockSparseMatrix build_rows(int rows, int cols, Body&& body) {
   std::vector<std::vector<std::pair<int, Matrix3>>> built(static_cast<std::size_t>(rows));
   tbb::enumerable_thread_specific<RowAccumulator> accumulators([cols] { return RowAccumulator(cols); });
-  parallel_rows(rows, [&](int k) {
+  // Always in parallel: unlike the per-iteration products, a set-up row costs many blocks.
+  tbb::parallel_for(tbb::blocked_range<int>(0, rows, 16), [&](const tbb::blocked_range<int>& range) {
     RowAccumulator& accumulator = accumulators.local();
-    body(k, accumulator);
-    built[static_cast<std::size_t>(k)] = accumulator.take();
+    for (int k = range.begin(); k != range.end(); ++k) {
+      body(k, accumulator);
+      built[static_cast<std::size_t>(k)] = accumulator.take();
+    }
   });
   BlockSparseMatrix A;
   A.rows = rows;
