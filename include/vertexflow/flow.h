@@ -33,8 +33,8 @@ enum class LinearSolver {
   /// The direct factorisation at or below 1,000 free vertices (a few milliseconds, exact).
   /// Above, conjugate gradients: Multilevel when the mesh has a flat region (|k1| + |k2| below
   /// 0.01 per mean edge length) of at least 500 connected free vertices, where block-Jacobi
-  /// needs 3-10x more iterations (fandisk: 930 against 129); Iterative otherwise, where the
-  /// multilevel set-up costs more than it saves (bunny_uniform: 79 iterations against 57). If
+  /// needs 3-8x more iterations (fandisk: 930 against 114); Iterative otherwise, where the
+  /// multilevel set-up costs more than it saves (bunny_uniform: 79 iterations against 55). If
   /// the iteration has not converged within 18 sqrt(free vertices) iterations (about what the
   /// factorisation would cost on this project's reference machine), the direct factorisation
   /// takes over when its predicted factor fits in 2 GiB, otherwise the iteration continues up

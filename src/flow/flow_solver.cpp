@@ -30,7 +30,7 @@
 // built on decoupled n x n factorisations (x, y, z, or per-vertex frames) and their two-level
 // combinations with Gauss-Seidel cost a factorisation each and still took 50-200 iterations,
 // so they lost to the two above everywhere; the aggregation coarse space needs no
-// factorisation of the fine problem and cuts fandisk from 930 to 129 iterations.
+// factorisation of the fine problem and cuts fandisk from 930 to 114 iterations.
 // The automatic rule is therefore competitive: below kDirectBelow free vertices factor
 // directly; otherwise iterate (with the multilevel preconditioner where a large flat region
 // predicts slow modes, kFlatRegionForMultilevel), and if the iteration has not converged after about the number
@@ -100,9 +100,9 @@ constexpr double kBudgetPerSqrtVertex = 18.0;
 // least kFlatRegionForMultilevel free vertices has |k1| + |k2| < kFlatCurvature (per mean edge
 // length): there F_em vanishes and block-Jacobi's iteration count grows like the region's
 // diameter squared. Measured (largest such region; block-Jacobi against multilevel
-// iterations): fandisk 1,257 vertices, 930 against 129; amo 4,825, 291 against 93; every other
+// iterations): fandisk 1,257 vertices, 930 against 114; amo 4,825, 291 against 97; every other
 // data mesh at most 105 vertices, where the set-up costs more than the iterations it saves
-// (bunny_uniform 79 against 57, horse-10k 98 against 53, each multilevel iteration ~1.3x).
+// (bunny_uniform 79 against 55, horse-10k 98 against 60, each multilevel iteration ~1.3x).
 constexpr double kFlatCurvature = 0.01;
 constexpr Index kFlatRegionForMultilevel = 500;
 // Without a fallback (the factorisation would not fit) the iteration stops at this many
@@ -569,7 +569,7 @@ class MultilevelCorrection {
           const Local* local = locals.get() + local_start[v];
           const Local& x = local[k];
           const Matrix3 left = x.g * t.P[v].full();
-          const Matrix3 D = t.fixed[v] ? Matrix3::Zero().eval() : t.D[v].full();
+          const Matrix3 D = t.D[v].full();                     // phi is 0 at fixed vertices, so their D drops out
           for (std::uint32_t q = k; q < local_size[v]; ++q) {  // sorted, so local[q].aggregate >= a
             const Local& y = local[q];
             Index& p = position[static_cast<std::size_t>(y.aggregate)];
@@ -612,8 +612,6 @@ class MultilevelCorrection {
     coarse_ = std::make_unique<AdditiveMultilevel>(std::move(coarse));
     restricted_.resize(3 * count_);
   }
-
-  [[nodiscard]] Index num_aggregates() const { return count_; }
 
   // z += Phi M_c Phi^T r; returns r . z (summed in chunks, as every dot product here).
   double add_to(const Vector& r, Vector& z) {

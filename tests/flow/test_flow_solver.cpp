@@ -145,8 +145,8 @@ TEST_P(FlowSolverAgree, SameMinimiserAndEnergy) {
 TEST(FlowSolver, MultilevelRemovesTheSlowModesOfFlatRegions) {
   // fandisk's flat faces leave tangential motion to F_smo's bi-Laplacian: block-Jacobi needs
   // about a thousand iterations, the multilevel preconditioner a few times fewer (measured at
-  // this tolerance: 1,124 against 177). On a smooth mesh both are fast, and the coarse space
-  // still helps (bunny_uniform: 102 against 73).
+  // this tolerance: 1,124 against 162). On a smooth mesh both are fast, and the coarse space
+  // still helps (bunny_uniform: 102 against 72).
   for (const auto& [file, ratio] : {std::pair{"fandisk.off", 4.0}, std::pair{"bunny_uniform.off", 1.2}}) {
     const Problem p = make_problem(read_mesh(test::data_path(file)));
     FlowReport block_jacobi, multilevel;

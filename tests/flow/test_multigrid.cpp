@@ -162,7 +162,7 @@ TEST(Multigrid, AdditiveMultilevelIsASymmetricPositivePreconditioner) {
 TEST(Multigrid, CutsTheIterationsOfABiLaplacian) {
   // Block-Jacobi's count grows like the side squared on a bi-Laplacian; the multilevel
   // operator's grows much more slowly (measured here: 1,733 against 495; on fandisk, with the
-  // flow solver's smoothed fine level on top, 1,124 against 177).
+  // flow solver's smoothed fine level on top, 1,124 against 162).
   const BlockSparseMatrix A = bilaplacian(40, 1e-6);
   const AdditiveMultilevel M(A);
   Eigen::VectorXd b(3 * A.rows);
