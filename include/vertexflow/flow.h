@@ -31,16 +31,19 @@ namespace vertexflow {
 /// How the flow's sparse linear system (the normal equations of flow_energy.h) is solved.
 enum class LinearSolver {
   /// The direct factorisation at or below 1,000 free vertices (a few milliseconds, exact).
-  /// Above, conjugate gradients: Multilevel when the mesh has a flat region (|k1| + |k2| below
-  /// 0.01 per mean edge length) of at least 500 connected free vertices, where block-Jacobi
-  /// needs 3-8x more iterations (fandisk: 930 against 114); Iterative otherwise, where the
-  /// multilevel set-up costs more than it saves (bunny_uniform: 79 iterations against 55). If
-  /// the iteration has not converged within 18 sqrt(free vertices) iterations (about what the
-  /// factorisation would cost on this project's reference machine), the direct factorisation
-  /// takes over when its predicted factor fits in 2 GiB, otherwise the iteration continues up
-  /// to ten times that budget. So the total is at most about twice the cheaper method's
-  /// (flow_solver.cpp explains the calibration). Deterministic: the choice depends only on the
-  /// mesh, its curvature and the iteration count, never on timings.
+  /// Above, conjugate gradients: Multilevel from the start when the mesh has a flat region
+  /// (|k1| + |k2| below 0.01 per mean edge length) of at least 500 connected free vertices,
+  /// where block-Jacobi needs 3-8x more iterations (fandisk: 930 against 114). Otherwise
+  /// Iterative, switching to Multilevel if the first 30 iterations predict more than about 105
+  /// in all (Lanczos estimate of the condition number): spot 222 -> 88, max-planck-5k 146 ->
+  /// 79; smooth meshes such as bunny_uniform (79) keep block-Jacobi, where the multilevel
+  /// set-up costs more than it saves. If the iteration has not converged within 18 sqrt(free
+  /// vertices) iterations (about what the factorisation would cost on this project's reference
+  /// machine), the direct factorisation takes over when its predicted factor fits in 2 GiB,
+  /// otherwise the iteration continues up to ten times that budget. So the total is at most
+  /// about twice the cheaper method's (flow_solver.cpp explains the calibration).
+  /// Deterministic: the choice depends only on the mesh, its curvature and the iteration's
+  /// coefficients, never on timings.
   Automatic,
   /// Sparse Cholesky of the coupled 3n x 3n normal matrix (CHOLMOD). Exact to rounding, but its
   /// time grows like n^1.5 and its memory like n log n: about 2 GB at 100k vertices.

@@ -105,6 +105,15 @@ constexpr double kBudgetPerSqrtVertex = 18.0;
 // (bunny_uniform 79 against 55, horse-10k 98 against 60, each multilevel iteration ~1.3x).
 constexpr double kFlatCurvature = 0.01;
 constexpr Index kFlatRegionForMultilevel = 500;
+// Otherwise block-Jacobi runs kProbeIterations, and if the Lanczos estimate of its total
+// (ConjugateGradients::predicted_iterations, a lower bound) is above kSwitchAbovePredicted the
+// iteration continues with the multilevel preconditioner. The set-up costs about 30-50
+// block-Jacobi iterations, and the multilevel count is 40-70% of block-Jacobi's, so it pays from
+// about 120 remaining iterations. Measured after 30 iterations (estimate; actual count):
+// bunny_uniform 67; 79, horse-48k 89; 93, rocker-arm 91; 90, armadillo-43k 95; 129 stay;
+// max-planck-5k 111; 146, fertility 113; 140, spot 121; 222, camelhead 149; 568 switch.
+constexpr int kProbeIterations = 30;
+constexpr double kSwitchAbovePredicted = 105;
 // Without a fallback (the factorisation would not fit) the iteration stops at this many
 // times the budget.
 constexpr int kIterationCapFactor = 10;
@@ -710,6 +719,16 @@ class MultilevelCorrection {
   Vector restricted_, coarse_solution_;
 };
 
+// The multilevel preconditioner, or null if its coarsest matrix lost definiteness to rounding
+// (degenerate input): block-Jacobi alone still converges, only more slowly.
+std::unique_ptr<MultilevelCorrection> make_multilevel(const Terms& terms) {
+  try {
+    return std::make_unique<MultilevelCorrection>(terms);
+  } catch (const std::runtime_error&) {
+    return nullptr;
+  }
+}
+
 struct IterationResult {
   int iterations = 0;
   bool converged = false;
@@ -756,6 +775,7 @@ class ConjugateGradients {
       pending_beta_.reset();
       if (!(curvature > 0)) break;  // H is positive definite; only rounding at convergence gets here
       const double alpha = rz_ / curvature;
+      alphas_.push_back(alpha);
       // d += alpha p, r -= alpha H p, z = M^-1 r; sums of r.r and r.z.
       const Eigen::Vector2d sums = chunked_sum(t_.n, Eigen::Vector2d::Zero().eval(), [&](Index i) {
         at(d_, i) += alpha * at(p_, i);
@@ -775,9 +795,42 @@ class ConjugateGradients {
         break;
       }
       pending_beta_ = rz / rz_;
+      betas_.push_back(*pending_beta_);
       rz_ = rz;
     }
     return result;
+  }
+
+  // The iterations that the current preconditioner is predicted to need in all, from the
+  // extreme eigenvalues of the Lanczos matrix of the iterations so far (Saad, Iterative
+  // Methods, 6.7.3): 1/2 sqrt(kappa) ln(2 / tolerance), the conjugate-gradient bound. After a
+  // few dozen iterations the smallest eigenvalue is still overestimated, so this is a lower
+  // bound, and the flat meshes' counts are underestimated most.
+  [[nodiscard]] double predicted_iterations(double tolerance) const {
+    const auto k = static_cast<Eigen::Index>(std::min(alphas_.size(), betas_.size() + 1));
+    if (k < 2) return 0;
+    Eigen::MatrixXd T = Eigen::MatrixXd::Zero(k, k);
+    for (Eigen::Index j = 0; j < k; ++j) {
+      const auto u = static_cast<std::size_t>(j);
+      T(j, j) = 1 / alphas_[u] + (j > 0 ? betas_[u - 1] / alphas_[u - 1] : 0.0);
+      if (j + 1 < k) T(j, j + 1) = T(j + 1, j) = std::sqrt(betas_[u]) / alphas_[u];
+    }
+    const Eigen::VectorXd eigenvalues =
+        Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(T, Eigen::EigenvaluesOnly).eigenvalues();
+    const double kappa = eigenvalues[k - 1] / std::max(eigenvalues[0], 1e-300);
+    return 0.5 * std::sqrt(kappa) * std::log(2 / tolerance);
+  }
+
+  // Continues from the current iterate with the multilevel preconditioner (a restart: the
+  // search directions so far were conjugate for the old one).
+  void use_multilevel(MultilevelCorrection* multilevel) {
+    multilevel_ = multilevel;
+    parallel_vertices(t_.n, [&](Index i) { at(z_, i) = inverse_[static_cast<std::size_t>(i)] * at(r_, i); });
+    rz_ = multilevel_->add_to(r_, z_);
+    p_ = z_;
+    pending_beta_.reset();
+    alphas_.clear();
+    betas_.clear();
   }
 
   const Vector& solution() const { return d_; }
@@ -788,6 +841,7 @@ class ConjugateGradients {
   Operator& op_;
   MultilevelCorrection* multilevel_;    // null: block-Jacobi alone
   std::optional<double> pending_beta_;  // p = z + beta p, done by the next operator application
+  std::vector<double> alphas_, betas_;  // of the iterations since the last preconditioner change
   std::vector<Sym3> inverse_;           // of H's diagonal blocks; zero at fixed vertices
   Vector d_, r_, z_, p_, hp_;
   double rz_ = 0, b_norm_ = 0, r_norm_ = 0;
@@ -1044,20 +1098,29 @@ Vertices FlowSystemSolver::solve(const FlowFrame& frame, const EnergyWeights& we
     start = Clock::now();
     std::unique_ptr<MultilevelCorrection> multilevel;
     if (s.kind == LinearSolver::Multilevel ||
-        (s.kind == LinearSolver::Automatic && largest_flat_region(terms) >= kFlatRegionForMultilevel)) {
-      try {
-        multilevel = std::make_unique<MultilevelCorrection>(terms);
-      } catch (const std::runtime_error&) {
-        // The coarsest matrix lost definiteness to rounding (degenerate input): block-Jacobi
-        // alone still converges, only more slowly.
-      }
-    }
+        (s.kind == LinearSolver::Automatic && largest_flat_region(terms) >= kFlatRegionForMultilevel))
+      multilevel = make_multilevel(terms);
     ConjugateGradients cg(terms, op, b, multilevel.get());
     report.seconds_factorization += seconds_since(start);
     start = Clock::now();
     const int budget = static_cast<int>(std::ceil(kBudgetPerSqrtVertex * std::sqrt(static_cast<double>(m))));
-    IterationResult result =
-        cg.run(s.kind == LinearSolver::Automatic ? budget : kIterationCapFactor * budget, s.tolerance);
+    IterationResult result;
+    if (s.kind == LinearSolver::Automatic && !multilevel) {
+      // Block-Jacobi first; if the first iterations predict a long run, switch.
+      result = cg.run(std::min(kProbeIterations, budget), s.tolerance);
+      if (!result.converged && cg.predicted_iterations(s.tolerance) > kSwitchAbovePredicted) {
+        report.seconds_solve += seconds_since(start);
+        start = Clock::now();
+        multilevel = make_multilevel(terms);
+        if (multilevel) cg.use_multilevel(multilevel.get());
+        report.seconds_factorization += seconds_since(start);
+        start = Clock::now();
+      }
+    }
+    if (!result.converged)
+      result =
+          cg.run((s.kind == LinearSolver::Automatic ? budget : kIterationCapFactor * budget) - cg.total_iterations(),
+                 s.tolerance);
     if (!result.converged && s.kind == LinearSolver::Automatic) {
       // Fall back to the factorisation if it fits; otherwise keep iterating.
       report.seconds_solve += seconds_since(start);

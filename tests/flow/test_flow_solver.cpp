@@ -180,6 +180,18 @@ TEST(FlowSolver, AutomaticChoice) {
   FlowReport flat;
   solve(fandisk, LinearSolver::Automatic, {}, &flat);
   EXPECT_EQ(flat.solver_used, LinearSolver::Multilevel);
+  // spot has no large flat region, but its first 30 block-Jacobi iterations predict a long run
+  // (at the default tolerance: 222 in all): the iteration continues with the multilevel
+  // preconditioner (88 in all).
+  const Problem spot = make_problem(read_mesh(test::data_path("spot.obj")));
+  FlowReport switched, forced;
+  const Vertices switched_result = solve(spot, LinearSolver::Automatic, {}, &switched);
+  solve(spot, LinearSolver::Iterative, {}, &forced);
+  EXPECT_EQ(switched.solver_used, LinearSolver::Multilevel);
+  EXPECT_GT(switched.solver_iterations, 30);
+  EXPECT_LT(2 * switched.solver_iterations, forced.solver_iterations);
+  EXPECT_LE(switched.solver_error, 1e-9);
+  EXPECT_LT(max_difference(switched_result, solve(spot, LinearSolver::Direct)), 2e-6);
   // A weak distance term and a tinier pull make camelhead's iteration exhaust its budget,
   // 18 sqrt(free vertices): the factorisation takes over and gives the exact minimiser.
   const Problem camelhead = make_problem(read_mesh(test::data_path("camelhead.off")));
@@ -196,8 +208,11 @@ TEST(FlowSolver, AutomaticChoice) {
 }
 
 TEST(FlowSolver, SameBytesForAnyThreadCount) {
+  // max-planck-5k: Automatic starts with block-Jacobi and switches to the multilevel
+  // preconditioner after its first iterations.
   const Problem p = make_problem(read_mesh(test::data_path("max-planck-5k.obj")));
-  for (const LinearSolver kind : {LinearSolver::Iterative, LinearSolver::Direct, LinearSolver::Multilevel}) {
+  for (const LinearSolver kind :
+       {LinearSolver::Iterative, LinearSolver::Direct, LinearSolver::Multilevel, LinearSolver::Automatic}) {
     Vertices one, two;
     {
       tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
