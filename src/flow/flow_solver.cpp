@@ -101,8 +101,7 @@ constexpr double kBudgetPerSqrtVertex = 18.0;
 // length): there F_em vanishes and block-Jacobi's iteration count grows like the region's
 // diameter squared. Measured (largest such region; block-Jacobi against multilevel
 // iterations): fandisk 1,257 vertices, 930 against 114; amo 4,825, 291 against 97; every other
-// data mesh at most 105 vertices, where the set-up costs more than the iterations it saves
-// (bunny_uniform 79 against 55, horse-10k 98 against 60, each multilevel iteration ~1.3x).
+// data mesh at most 105 vertices. Starting multilevel at once saves the probe below.
 constexpr double kFlatCurvature = 0.01;
 constexpr Index kFlatRegionForMultilevel = 500;
 // Otherwise block-Jacobi runs kProbeIterations, and if the Lanczos estimate of its total
