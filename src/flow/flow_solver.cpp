@@ -511,19 +511,26 @@ class MultilevelCorrection {
     // Per vertex i (the rows of A at i, fixed vertices included): for each aggregate a whose
     // basis function is non-zero on the star of i, phi_a(i), the 3x3 block (G Phi_a)_i and the
     // entry (L phi_a)_i.
-    std::vector<std::size_t> local_start(n + 1, 0);
-    for (std::size_t i = 0; i < n; ++i) {
-      std::size_t capacity = basis_size_[i];
-      const auto [begin, end] = t.one_ring(static_cast<Index>(i));
-      for (const Index* j = begin; j != end; ++j) capacity += basis_size_[static_cast<std::size_t>(*j)];
-      local_start[i + 1] = local_start[i] + capacity;
-    }
-    // Not value-initialised: only the used part of each vertex's capacity is written (and touched).
-    const std::unique_ptr<Local[]> locals(new Local[local_start[n]]);
+    // Sizes first (the distinct aggregates of the star's basis functions), so that the locals
+    // take what they need: reserving the worst case per vertex tripled amo's peak memory.
     std::vector<std::uint32_t> local_size(n, 0);
+    tbb::enumerable_thread_specific<std::vector<Index>> seen;
+    parallel_vertices(t.n, [&](Index i) {
+      std::vector<Index>& aggregates = seen.local();
+      aggregates.clear();
+      t.for_each_in_star(i, [&](Index u) {
+        for (const Weight& w : basis(u)) aggregates.push_back(w.aggregate);
+      });
+      std::sort(aggregates.begin(), aggregates.end());
+      local_size[static_cast<std::size_t>(i)] =
+          static_cast<std::uint32_t>(std::unique(aggregates.begin(), aggregates.end()) - aggregates.begin());
+    });
+    std::vector<std::size_t> local_start(n + 1, 0);
+    for (std::size_t i = 0; i < n; ++i) local_start[i + 1] = local_start[i] + local_size[i];
+    std::vector<Local> locals(local_start[n]);
     parallel_vertices(t.n, [&](Index i) {
       const auto v = static_cast<std::size_t>(i);
-      Local* out = locals.get() + local_start[v];
+      Local* out = locals.data() + local_start[v];
       std::uint32_t size = 0;
       auto find = [&](Index a) -> Local& {
         for (std::uint32_t k = 0; k < size; ++k)
@@ -548,7 +555,6 @@ class MultilevelCorrection {
         }
       }
       std::sort(out, out + size, [](const Local& x, const Local& y) { return x.aggregate < y.aggregate; });
-      local_size[v] = size;
     });
     // The locals of each aggregate, by vertex (counting sort, so in vertex order).
     const auto na = static_cast<std::size_t>(count_);
@@ -574,7 +580,7 @@ class MultilevelCorrection {
         for (std::size_t m = touch_start[a]; m < touch_start[a + 1]; ++m) {
           const auto [i, k] = touches[m];
           const auto v = static_cast<std::size_t>(i);
-          const Local* local = locals.get() + local_start[v];
+          const Local* local = locals.data() + local_start[v];
           const Local& x = local[k];
           const Matrix3 left = x.g * t.P[v].full();
           const Matrix3 D = t.D[v].full();                     // phi is 0 at fixed vertices, so their D drops out
