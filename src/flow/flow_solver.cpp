@@ -516,14 +516,14 @@ class MultilevelCorrection {
     std::vector<std::uint32_t> local_size(n, 0);
     tbb::enumerable_thread_specific<std::vector<Index>> seen;
     parallel_vertices(t.n, [&](Index i) {
-      std::vector<Index>& aggregates = seen.local();
+      std::vector<Index>& aggregates = seen.local();  // distinct, a handful: linear search
       aggregates.clear();
       t.for_each_in_star(i, [&](Index u) {
-        for (const Weight& w : basis(u)) aggregates.push_back(w.aggregate);
+        for (const Weight& w : basis(u))
+          if (std::find(aggregates.begin(), aggregates.end(), w.aggregate) == aggregates.end())
+            aggregates.push_back(w.aggregate);
       });
-      std::sort(aggregates.begin(), aggregates.end());
-      local_size[static_cast<std::size_t>(i)] =
-          static_cast<std::uint32_t>(std::unique(aggregates.begin(), aggregates.end()) - aggregates.begin());
+      local_size[static_cast<std::size_t>(i)] = static_cast<std::uint32_t>(aggregates.size());
     });
     std::vector<std::size_t> local_start(n + 1, 0);
     for (std::size_t i = 0; i < n; ++i) local_start[i + 1] = local_start[i] + local_size[i];
