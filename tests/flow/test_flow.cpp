@@ -3,6 +3,7 @@
 #include "shapes.h"
 #include "test_support.h"
 
+#include "vertexflow/compare.h"
 #include "vertexflow/distance.h"
 #include "vertexflow/flow.h"
 #include "vertexflow/io.h"
@@ -71,6 +72,37 @@ INSTANTIATE_TEST_SUITE_P(Data, FlowOnMesh,
                                            "bunny_adaptive.off", "amo_adaptive.off", "sphere_low.off", "suzanne.obj",
                                            "fandisk_quads.off", "chamfer-cube.off", "icosahedron_binary.stl"),
                          [](const auto& param_info) { return test::test_name(param_info.param); });
+
+// Issue 4's redistribution and edge-error bars at the default options, measured as the report
+// measures them (compare_meshes: input curvature at each vertex's closest point on the input).
+// bunny_uniform and fandisk start near-uniform: rho rises by >= 0.2 (measured +0.355 and
+// +0.471) and the edge-error CV falls by >= 10% (11.8% and 13.0%). max-planck-5k is a QEM
+// decimation, already graded (rho 0.712): the paper's energy evens its edge errors out (CV
+// -11.3%) but cannot raise rho much (docs/redistribution.md); it must not lower it.
+struct RedistributionCase {
+  const char* file;
+  double min_rho_gain;
+};
+
+class FlowRedistribution : public ::testing::TestWithParam<RedistributionCase> {};
+
+TEST_P(FlowRedistribution, MeetsTheRedistributionAndEdgeErrorBars) {
+  const Mesh mesh = read_mesh(test::data_path(GetParam().file));
+  Mesh result = mesh;
+  result.V = vertex_flow(mesh.V, mesh.F).V;
+  CompareOptions options;
+  options.sampling.samples = 1000;  // distances are not what this test is about
+  const MeshComparison c = compare_meshes(result, mesh, nullptr, options);
+  EXPECT_GE(c.redistribution_rho_result - c.redistribution_rho_input, GetParam().min_rho_gain)
+      << c.redistribution_rho_input << " -> " << c.redistribution_rho_result;
+  EXPECT_LE(c.edge_error_result.coefficient_of_variation, 0.9 * c.edge_error_input.coefficient_of_variation);
+}
+
+INSTANTIATE_TEST_SUITE_P(Data, FlowRedistribution,
+                         ::testing::Values(RedistributionCase{"bunny_uniform.off", 0.2},
+                                           RedistributionCase{"fandisk.off", 0.2},
+                                           RedistributionCase{"max-planck-5k.obj", -0.01}),
+                         [](const auto& param_info) { return test::test_name(param_info.param.file); });
 
 // Hard cases (issue 4): an unguarded solve flips faces on each; the guarded flow must not.
 TEST(FlowHardCases, ThinPerforatedPlateOfGenus16) {
