@@ -569,59 +569,25 @@ class MultilevelCorrection {
           touches[fill[static_cast<std::size_t>(locals[local_start[i] + k].aggregate)]++] = {static_cast<Index>(i), k};
     }
     // Row a of the upper half of H_c: blocks (a, b), b >= a, summed over the vertices in order.
-    std::vector<std::vector<std::pair<Index, Matrix3>>> rows(na);
-    tbb::enumerable_thread_specific<std::vector<Index>> positions([na] { return std::vector<Index>(na, -1); });
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, na, 64), [&](const tbb::blocked_range<std::size_t>& range) {
-      std::vector<Index>& position = positions.local();
-      for (std::size_t a = range.begin(); a != range.end(); ++a) {
-        auto& row = rows[a];
-        for (std::size_t m = touch_start[a]; m < touch_start[a + 1]; ++m) {
-          const auto [i, k] = touches[m];
-          const auto v = static_cast<std::size_t>(i);
-          const Local* local = locals.data() + local_start[v];
-          const Local& x = local[k];
-          const Matrix3 left = x.g * t.P[v].full();
-          const Matrix3 D = t.D[v].full();                     // phi is 0 at fixed vertices, so their D drops out
-          for (std::uint32_t q = k; q < local_size[v]; ++q) {  // sorted, so local[q].aggregate >= a
-            const Local& y = local[q];
-            Index& p = position[static_cast<std::size_t>(y.aggregate)];
-            if (p < 0) {
-              p = static_cast<Index>(row.size());
-              row.emplace_back(y.aggregate, Matrix3::Zero());
-            }
-            Matrix3& block = row[static_cast<std::size_t>(p)].second;
-            block.noalias() += left * y.g;
-            block.diagonal().array() += t.smooth[v] * x.l * y.l;
-            block.noalias() += (x.phi * y.phi) * D;
-          }
+    const BlockSparseMatrix upper = build_block_rows(count_, count_, [&](int a, BlockRowAccumulator& row) {
+      for (std::size_t m = touch_start[static_cast<std::size_t>(a)]; m < touch_start[static_cast<std::size_t>(a) + 1];
+           ++m) {
+        const auto [i, k] = touches[m];
+        const auto v = static_cast<std::size_t>(i);
+        const Local* local = locals.data() + local_start[v];
+        const Local& x = local[k];
+        const Matrix3 left = x.g * t.P[v].full();
+        const Matrix3 D = t.D[v].full();                     // phi is 0 at fixed vertices, so their D drops out
+        for (std::uint32_t q = k; q < local_size[v]; ++q) {  // sorted, so local[q].aggregate >= a
+          const Local& y = local[q];
+          Matrix3& block = row[y.aggregate];
+          block.noalias() += left * y.g;
+          block.diagonal().array() += t.smooth[v] * x.l * y.l;
+          block.noalias() += (x.phi * y.phi) * D;
         }
-        for (const auto& entry : row) position[static_cast<std::size_t>(entry.first)] = -1;
       }
     });
-    // Both halves, rows sorted by column.
-    std::vector<std::vector<std::pair<Index, Matrix3>>> full(na);
-    for (std::size_t a = 0; a < na; ++a)
-      for (const auto& [b, block] : rows[a]) {
-        full[a].emplace_back(b, block);
-        if (b != static_cast<Index>(a))
-          full[static_cast<std::size_t>(b)].emplace_back(static_cast<Index>(a), block.transpose());
-      }
-    BlockSparseMatrix coarse;
-    coarse.rows = coarse.cols = count_;
-    coarse.start.assign(na + 1, 0);
-    for (std::size_t a = 0; a < na; ++a) coarse.start[a + 1] = coarse.start[a] + static_cast<int>(full[a].size());
-    coarse.column.resize(static_cast<std::size_t>(coarse.start[na]));
-    coarse.block.resize(static_cast<std::size_t>(coarse.start[na]));
-    parallel_vertices(count_, [&](Index a) {
-      auto& row = full[static_cast<std::size_t>(a)];
-      std::sort(row.begin(), row.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
-      auto m = static_cast<std::size_t>(coarse.start[static_cast<std::size_t>(a)]);
-      for (const auto& [b, block] : row) {
-        coarse.column[m] = b;
-        coarse.block[m++] = block;
-      }
-    });
-    coarse_ = std::make_unique<AdditiveMultilevel>(std::move(coarse));
+    coarse_ = std::make_unique<AdditiveMultilevel>(symmetric_from_upper(upper));
     restricted_.resize(3 * count_);
   }
 
@@ -1144,7 +1110,7 @@ Vertices FlowSystemSolver::solve(const FlowFrame& frame, const EnergyWeights& we
   }
   if (direct && m > 0) d = s.factor_and_solve(terms, b, report);
   if (m == 0) d = Vector::Zero(b.size());
-  report.solver_used = direct ? LinearSolver::Direct : used;
+  report.solver_used = used;
 
   // The relative residual of the normal equations, independent of the method.
   start = Clock::now();

@@ -44,63 +44,6 @@ Eigen::Map<Vector3> at(Eigen::VectorXd& v, int k) {
   return Eigen::Map<Vector3>(v.data() + 3 * k);
 }
 
-// The blocks of one output row, keyed by column (a sparse accumulator).
-class RowAccumulator {
- public:
-  explicit RowAccumulator(int cols) : position_(static_cast<std::size_t>(cols), -1) {}
-  Matrix3& operator[](int column) {
-    int& p = position_[static_cast<std::size_t>(column)];
-    if (p < 0) {
-      p = static_cast<int>(entries_.size());
-      entries_.emplace_back(column, Matrix3::Zero());
-    }
-    return entries_[static_cast<std::size_t>(p)].second;
-  }
-  // Moves the row out, sorted by column, and clears the accumulator.
-  std::vector<std::pair<int, Matrix3>> take() {
-    for (const auto& entry : entries_) position_[static_cast<std::size_t>(entry.first)] = -1;
-    std::sort(entries_.begin(), entries_.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-    return std::exchange(entries_, {});
-  }
-
- private:
-  std::vector<int> position_;
-  std::vector<std::pair<int, Matrix3>> entries_;
-};
-
-// A rows x cols block matrix whose row k is body(k, accumulator), rows built in parallel (each
-// row's sums in the order body adds them, so the result does not depend on the threads).
-template <class Body>
-BlockSparseMatrix build_rows(int rows, int cols, Body&& body) {
-  std::vector<std::vector<std::pair<int, Matrix3>>> built(static_cast<std::size_t>(rows));
-  tbb::enumerable_thread_specific<RowAccumulator> accumulators([cols] { return RowAccumulator(cols); });
-  // Always in parallel: unlike the per-iteration products, a set-up row costs many blocks.
-  tbb::parallel_for(tbb::blocked_range<int>(0, rows, 16), [&](const tbb::blocked_range<int>& range) {
-    RowAccumulator& accumulator = accumulators.local();
-    for (int k = range.begin(); k != range.end(); ++k) {
-      body(k, accumulator);
-      built[static_cast<std::size_t>(k)] = accumulator.take();
-    }
-  });
-  BlockSparseMatrix A;
-  A.rows = rows;
-  A.cols = cols;
-  A.start.assign(static_cast<std::size_t>(rows) + 1, 0);
-  for (int k = 0; k < rows; ++k)
-    A.start[static_cast<std::size_t>(k) + 1] =
-        A.start[static_cast<std::size_t>(k)] + static_cast<int>(built[static_cast<std::size_t>(k)].size());
-  A.column.resize(static_cast<std::size_t>(A.start.back()));
-  A.block.resize(static_cast<std::size_t>(A.start.back()));
-  parallel_rows(rows, [&](int k) {
-    auto m = static_cast<std::size_t>(A.start[static_cast<std::size_t>(k)]);
-    for (const auto& [column, block] : built[static_cast<std::size_t>(k)]) {
-      A.column[m] = column;
-      A.block[m++] = block;
-    }
-  });
-  return A;
-}
-
 BlockSparseMatrix transpose(const BlockSparseMatrix& A) {
   BlockSparseMatrix T;
   T.rows = A.cols;
@@ -168,6 +111,66 @@ double spectral_radius(const std::vector<Matrix3>& inverse_diagonal, const Block
 }
 
 }  // namespace
+
+BlockRowAccumulator::BlockRowAccumulator(int cols) : position_(static_cast<std::size_t>(cols), -1) {}
+
+Matrix3& BlockRowAccumulator::operator[](int column) {
+  int& p = position_[static_cast<std::size_t>(column)];
+  if (p < 0) {
+    p = static_cast<int>(entries_.size());
+    entries_.emplace_back(column, Matrix3::Zero());
+  }
+  return entries_[static_cast<std::size_t>(p)].second;
+}
+
+std::vector<std::pair<int, Matrix3>> BlockRowAccumulator::take() {
+  for (const auto& entry : entries_) position_[static_cast<std::size_t>(entry.first)] = -1;
+  std::sort(entries_.begin(), entries_.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+  return std::exchange(entries_, {});
+}
+
+BlockSparseMatrix build_block_rows(int rows, int cols, const std::function<void(int, BlockRowAccumulator&)>& body) {
+  std::vector<std::vector<std::pair<int, Matrix3>>> built(static_cast<std::size_t>(rows));
+  tbb::enumerable_thread_specific<BlockRowAccumulator> accumulators([cols] { return BlockRowAccumulator(cols); });
+  // Always in parallel: unlike the per-iteration products, a set-up row costs many blocks.
+  tbb::parallel_for(tbb::blocked_range<int>(0, rows, 16), [&](const tbb::blocked_range<int>& range) {
+    BlockRowAccumulator& accumulator = accumulators.local();
+    for (int k = range.begin(); k != range.end(); ++k) {
+      body(k, accumulator);
+      built[static_cast<std::size_t>(k)] = accumulator.take();
+    }
+  });
+  BlockSparseMatrix A;
+  A.rows = rows;
+  A.cols = cols;
+  A.start.assign(static_cast<std::size_t>(rows) + 1, 0);
+  for (int k = 0; k < rows; ++k)
+    A.start[static_cast<std::size_t>(k) + 1] =
+        A.start[static_cast<std::size_t>(k)] + static_cast<int>(built[static_cast<std::size_t>(k)].size());
+  A.column.resize(static_cast<std::size_t>(A.start.back()));
+  A.block.resize(static_cast<std::size_t>(A.start.back()));
+  parallel_rows(rows, [&](int k) {
+    auto m = static_cast<std::size_t>(A.start[static_cast<std::size_t>(k)]);
+    for (const auto& [column, block] : built[static_cast<std::size_t>(k)]) {
+      A.column[m] = column;
+      A.block[m++] = block;
+    }
+  });
+  return A;
+}
+
+BlockSparseMatrix symmetric_from_upper(const BlockSparseMatrix& upper) {
+  // Row k of the result: the strictly lower blocks (row k of upper's transpose, columns < k),
+  // then row k of upper (columns >= k); both parts are sorted, so the row is.
+  const BlockSparseMatrix lower = transpose(upper);
+  return build_block_rows(upper.rows, upper.cols, [&](int k, BlockRowAccumulator& row) {
+    for (int m = lower.start[static_cast<std::size_t>(k)]; m < lower.start[static_cast<std::size_t>(k) + 1]; ++m)
+      if (lower.column[static_cast<std::size_t>(m)] != k)
+        row[lower.column[static_cast<std::size_t>(m)]] = lower.block[static_cast<std::size_t>(m)];
+    for (int m = upper.start[static_cast<std::size_t>(k)]; m < upper.start[static_cast<std::size_t>(k) + 1]; ++m)
+      row[upper.column[static_cast<std::size_t>(m)]] = upper.block[static_cast<std::size_t>(m)];
+  });
+}
 
 void BlockSparseMatrix::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
   y.resize(3 * static_cast<Eigen::Index>(rows));
@@ -249,7 +252,7 @@ AdditiveMultilevel::AdditiveMultilevel(BlockSparseMatrix A, int coarsest_unknown
     Level level;
     level.block_inverse = block_diagonal_inverse(A);
     const double omega = 4.0 / (3.0 * spectral_radius(level.block_inverse, A));
-    level.P = build_rows(A.rows, count, [&](int k, RowAccumulator& row) {
+    level.P = build_block_rows(A.rows, count, [&](int k, BlockRowAccumulator& row) {
       const auto a = aggregate[static_cast<std::size_t>(k)];
       row[a].diagonal().array() += scale[static_cast<std::size_t>(a)];
       const Matrix3 damped = omega * level.block_inverse[static_cast<std::size_t>(k)];
@@ -260,7 +263,7 @@ AdditiveMultilevel::AdditiveMultilevel(BlockSparseMatrix A, int coarsest_unknown
     });
     level.R = transpose(level.P);
     // Galerkin: A_c = R (A P).
-    const BlockSparseMatrix AP = build_rows(A.rows, count, [&](int k, RowAccumulator& row) {
+    const BlockSparseMatrix AP = build_block_rows(A.rows, count, [&](int k, BlockRowAccumulator& row) {
       for (int m = A.start[static_cast<std::size_t>(k)]; m < A.start[static_cast<std::size_t>(k) + 1]; ++m) {
         const int l = A.column[static_cast<std::size_t>(m)];
         const Matrix3& a = A.block[static_cast<std::size_t>(m)];
@@ -269,7 +272,7 @@ AdditiveMultilevel::AdditiveMultilevel(BlockSparseMatrix A, int coarsest_unknown
           row[level.P.column[static_cast<std::size_t>(q)]].noalias() += a * level.P.block[static_cast<std::size_t>(q)];
       }
     });
-    BlockSparseMatrix coarse = build_rows(count, count, [&](int i, RowAccumulator& row) {
+    BlockSparseMatrix coarse = build_block_rows(count, count, [&](int i, BlockRowAccumulator& row) {
       for (int m = level.R.start[static_cast<std::size_t>(i)]; m < level.R.start[static_cast<std::size_t>(i) + 1];
            ++m) {
         const int k = level.R.column[static_cast<std::size_t>(m)];

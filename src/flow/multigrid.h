@@ -16,6 +16,8 @@
 
 #include <Eigen/Dense>
 
+#include <functional>
+#include <utility>
 #include <vector>
 
 namespace vertexflow {
@@ -31,6 +33,29 @@ struct BlockSparseMatrix {
   /// y = A x (3 entries per block row / column).
   void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
 };
+
+/// The blocks of one row under construction, keyed by column (a sparse accumulator):
+/// row[column] is the block, zero when first touched.
+class BlockRowAccumulator {
+ public:
+  explicit BlockRowAccumulator(int cols);
+  Eigen::Matrix3d& operator[](int column);
+  /// Moves the row out, sorted by column, and clears the accumulator.
+  std::vector<std::pair<int, Eigen::Matrix3d>> take();
+
+ private:
+  std::vector<int> position_;
+  std::vector<std::pair<int, Eigen::Matrix3d>> entries_;
+};
+
+/// A rows x cols block matrix whose row k is what body(k, row) adds to `row`. Rows are built
+/// in parallel, each row's blocks summed in the order body adds them, so the result does not
+/// depend on the threads.
+BlockSparseMatrix build_block_rows(int rows, int cols, const std::function<void(int, BlockRowAccumulator&)>& body);
+
+/// The symmetric matrix whose upper half (diagonal included) is `upper`'s; `upper` must hold
+/// no block below the diagonal.
+BlockSparseMatrix symmetric_from_upper(const BlockSparseMatrix& upper);
 
 /// Greedy aggregation of a graph (Vanek et al.'s three phases): a node whose neighbours are all
 /// free of aggregates starts one with them; the remaining nodes join the aggregate of a
