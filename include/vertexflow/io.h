@@ -14,7 +14,9 @@
 //
 // Every failure throws IoError with a one-line message that starts with the file name.
 // Allocation is bounded by the file's size: a header that claims more elements than the file
-// can hold is an error, not an allocation.
+// can hold is an error, not an allocation. gzip input is parsed as it is inflated: the header
+// is checked after the first bytes, memory follows what is read, and the inflated size is
+// capped (ReadOptions::max_inflate_ratio).
 #pragma once
 
 #include "vertexflow/mesh.h"
@@ -43,16 +45,27 @@ MeshFormat format_from_path(const std::filesystem::path& path);
 /// Whether the path ends in ".gz" (case-insensitive).
 bool is_gzip_path(const std::filesystem::path& path);
 
+/// 32, or the environment variable VERTEXFLOW_MAX_INFLATE_RATIO when it holds a positive number
+/// (read once, at the first call).
+double default_max_inflate_ratio();
+
 struct ReadOptions {
-  /// Upper bound on the decompressed size of a gzip file; a larger stream is an error.
-  std::uint64_t max_decompressed_bytes = std::uint64_t{16} << 30;
+  /// gzip input is inflated as the parser reads it, and may inflate to at most
+  /// max(inflate_floor_bytes, max_inflate_ratio x its compressed size) bytes; more is an error
+  /// (a decompression bomb). Real meshes compress 1-12 times (the bundled ones, gzip -9), so
+  /// the default ratio leaves room; the floor lets small files of any ratio through.
+  double max_inflate_ratio = default_max_inflate_ratio();
+  std::uint64_t inflate_floor_bytes = std::uint64_t{64} << 20;
   /// Remove faces whose area is below kDegenerateAreaRelative * diagonal^2.
   bool remove_zero_area_faces = true;
 };
 
 /// What reading had to change to produce a clean triangle mesh. Every count is also a warning.
 struct ReadReport {
+  /// The format read: the extension's, unless the content is beyond doubt another format's
+  /// (a PLY header in a file named .obj, a binary STL by its size), which then wins.
   MeshFormat format = MeshFormat::Obj;
+  bool format_differs_from_extension = false;
   bool binary = false;
   bool gzip = false;
   /// Polygons with more than three vertices that were triangulated.
@@ -72,7 +85,8 @@ struct ReadReport {
   [[nodiscard]] std::vector<std::string> warnings() const;
 };
 
-/// Reads a mesh, choosing the format from the extension. Throws IoError.
+/// Reads a mesh, choosing the format from the extension unless the content shows another
+/// (ReadReport::format). Throws IoError, also when memory runs out.
 Mesh read_mesh(const std::filesystem::path& path, ReadReport* report = nullptr, const ReadOptions& options = {});
 
 /// Reads a mesh from bytes already in memory (used by the fuzzers and by read_mesh).

@@ -1,6 +1,7 @@
 // Internal pieces shared by the readers and writers. Not installed.
 #pragma once
 
+#include "byte_source.h"
 #include "vertexflow/io.h"
 
 #include <charconv>
@@ -41,11 +42,12 @@ struct PolygonSoup {
 /// Throws IoError("name: message").
 [[noreturn]] void fail(const std::string& name, const std::string& message);
 
-// Parsers: bytes (already decompressed) -> soup. Each throws IoError naming `name`.
-PolygonSoup parse_obj(std::string_view bytes, const std::string& name);
-PolygonSoup parse_ply(std::string_view bytes, const std::string& name, ReadReport& report);
-PolygonSoup parse_off(std::string_view bytes, const std::string& name, ReadReport& report);
-PolygonSoup parse_stl(std::string_view bytes, const std::string& name, ReadReport& report);
+// Parsers: bytes -> soup, pulling from the source only what they read. Each throws IoError
+// naming `name`.
+PolygonSoup parse_obj(ByteSource& source, const std::string& name);
+PolygonSoup parse_ply(ByteSource& source, const std::string& name, ReadReport& report);
+PolygonSoup parse_off(ByteSource& source, const std::string& name, ReadReport& report);
+PolygonSoup parse_stl(ByteSource& source, const std::string& name, ReadReport& report);
 
 /// Validates the soup and turns it into a clean triangle mesh (see io.h for what is removed).
 Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& report,
@@ -66,9 +68,6 @@ inline std::uint64_t edge_key(Index a, Index b) {
 /// degenerate).
 bool triangulate_polygon(const double* xyz, const Index* corners, std::size_t count, EdgeSet& edges,
                          std::vector<Index>& out);
-
-/// Inflates gzip data; throws if the result would exceed max_bytes.
-std::string gunzip(std::string_view compressed, const std::string& name, std::uint64_t max_bytes);
 
 /// True for data starting with the gzip magic bytes.
 inline bool has_gzip_magic(std::string_view bytes) {
@@ -119,28 +118,41 @@ inline void append_int(std::string& out, std::int64_t value) {
   out.append(buffer, result.ptr);
 }
 
-/// A cursor over ASCII text that reports errors with the line number.
-/// Line numbers are counted only when an error is reported, so scanning stays fast.
+/// A cursor over ASCII text that reports errors with the line number. It reads either a
+/// fixed view or a ByteSource, which it asks for more bytes when it reaches the end of what is
+/// available (and lets drop what it has passed), so text parsers stream through gzip input.
+/// Positions are those of the whole content. A token (a string_view) stays valid until the
+/// next call on the scanner. Line numbers are counted only when an error is reported.
 class TextScanner {
  public:
   TextScanner(std::string_view text, const std::string& name) : text_(text), name_(name) {}
+  TextScanner(ByteSource& source, const std::string& name)
+      : source_(&source), text_(source.data()), base_(source.offset()), name_(name) {}
 
-  [[nodiscard]] std::size_t position() const { return pos_; }
-  [[nodiscard]] bool at_end() const { return pos_ >= text_.size(); }
-  [[nodiscard]] char peek() const { return pos_ < text_.size() ? text_[pos_] : '\0'; }
-  [[nodiscard]] std::size_t remaining() const { return text_.size() - pos_; }
-  [[nodiscard]] std::string_view rest() const { return text_.substr(pos_); }
+  [[nodiscard]] std::size_t position() const { return base_ + pos_; }
+  /// Whether `n` more bytes are available (asking the source for them if needed).
+  bool has(std::size_t n = 1) { return pos_ + n <= text_.size() || fill(pos_ + n, pos_); }
+  bool at_end() { return !has(); }
+  char peek() { return has() ? text_[pos_] : '\0'; }
+  /// Up to `n` bytes from the current position (fewer at the end of the input).
+  std::string_view lookahead(std::size_t n) {
+    has(n);
+    return text_.substr(std::min(pos_, text_.size()), n);
+  }
+  /// An upper bound on the bytes left: exact for plain input, the inflation limit for gzip.
+  [[nodiscard]] std::uint64_t remaining_bound() const {
+    const std::uint64_t total = source_ ? source_->size_bound() : text_.size();
+    return total > position() ? total - position() : 0;
+  }
   void advance(std::size_t n) { pos_ += n; }
 
   /// Skips spaces and tabs (and a '\r'), not newlines.
   void skip_blanks() {
-    while (pos_ < text_.size() &&
-           (text_[pos_] == ' ' || text_[pos_] == '\t' || text_[pos_] == '\r'))
-      ++pos_;
+    while (has() && (text_[pos_] == ' ' || text_[pos_] == '\t' || text_[pos_] == '\r')) ++pos_;
   }
   /// Skips all whitespace including newlines; with `comments`, also '#' to end of line.
   void skip_whitespace(bool comments = false) {
-    while (pos_ < text_.size()) {
+    while (has()) {
       const char c = text_[pos_];
       if (c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v') {
         ++pos_;
@@ -153,25 +165,26 @@ class TextScanner {
   }
   /// Moves past the next '\n' (or to the end).
   void skip_line() {
-    const std::size_t nl = text_.find('\n', pos_);
-    pos_ = nl == std::string_view::npos ? text_.size() : nl + 1;
+    for (;;) {
+      const std::size_t nl = text_.find('\n', pos_);
+      if (nl != std::string_view::npos) {
+        pos_ = nl + 1;
+        return;
+      }
+      pos_ = std::max(pos_, text_.size());
+      if (!fill(pos_ + 1, pos_)) return;
+    }
   }
-  [[nodiscard]] bool at_line_end() const {
-    return pos_ >= text_.size() || text_[pos_] == '\n' || text_[pos_] == '#';
-  }
+  bool at_line_end() { return !has() || text_[pos_] == '\n' || text_[pos_] == '#'; }
   /// The next whitespace-delimited token on the current line (empty at the line's end).
   std::string_view token_on_line() {
     skip_blanks();
-    const std::size_t start = pos_;
-    while (pos_ < text_.size() && !is_space(text_[pos_])) ++pos_;
-    return text_.substr(start, pos_ - start);
+    return scan_token();
   }
   /// The next token, crossing lines (and comments when `comments`).
   std::string_view token(bool comments = false) {
     skip_whitespace(comments);
-    const std::size_t start = pos_;
-    while (pos_ < text_.size() && !is_space(text_[pos_])) ++pos_;
-    return text_.substr(start, pos_ - start);
+    return scan_token();
   }
 
   /// Parses a number from a token; fails with "expected WHAT".
@@ -214,9 +227,37 @@ class TextScanner {
   static std::string printable(std::string_view tok);
 
  private:
+  // The token starting at the current position; the source keeps its first byte while more
+  // bytes are fetched.
+  std::string_view scan_token() {
+    std::size_t start = pos_;
+    for (;;) {
+      while (pos_ < text_.size() && !is_space(text_[pos_])) ++pos_;
+      if (pos_ < text_.size()) break;
+      const std::size_t start_position = base_ + start;
+      if (!fill(pos_ + 1, start)) break;
+      start = start_position - base_;
+    }
+    return text_.substr(std::min(start, text_.size()), pos_ - start);
+  }
+
+  // Asks the source for bytes up to view index `end`, letting it drop those before view index
+  // `keep`; refreshes the view, which may have moved, and the index of the current position.
+  bool fill(std::size_t end, std::size_t keep) {
+    if (source_ == nullptr) return false;
+    const std::size_t position = base_ + pos_;
+    const bool ok = source_->request(base_ + end, base_ + keep);
+    text_ = source_->data();
+    base_ = source_->offset();
+    pos_ = position - base_;
+    return ok;
+  }
+
+  ByteSource* source_ = nullptr;
   std::string_view text_;
+  std::size_t base_ = 0;  // position of text_[0] in the content
   const std::string& name_;
-  std::size_t pos_ = 0;
+  std::size_t pos_ = 0;  // index into text_
 };
 
 }  // namespace vertexflow::io_detail

@@ -14,7 +14,10 @@
 #include <array>
 #include <cerrno>
 #include <cmath>
+#include <cstdlib>
+#include <iterator>
 #include <memory>
+#include <optional>
 #include <unordered_map>
 
 namespace vertexflow {
@@ -31,7 +34,9 @@ void fail(const std::string& name, const std::string& message) {
 
 void TextScanner::error(const std::string& message) const {
   const std::size_t end = std::min(pos_, text_.size());
-  const auto line = 1 + std::count(text_.begin(), text_.begin() + static_cast<std::ptrdiff_t>(end), '\n');
+  const std::uint64_t line = 1 + (source_ ? source_->newlines_dropped() : 0) +
+                             static_cast<std::uint64_t>(
+                                 std::count(text_.begin(), text_.begin() + static_cast<std::ptrdiff_t>(end), '\n'));
   fail(name_, fmt::format("line {}: {}", line, message));
 }
 
@@ -41,53 +46,6 @@ std::string TextScanner::printable(std::string_view tok) {
     out.push_back(static_cast<unsigned char>(c) < 32 || static_cast<unsigned char>(c) > 126 ? '?' : c);
   }
   if (tok.size() > 40) out += "...";
-  return out;
-}
-
-std::string gunzip(std::string_view compressed, const std::string& name, std::uint64_t max_bytes) {
-  z_stream stream{};
-  // 16 + MAX_WBITS: expect a gzip header; concatenated members are handled by the loop below.
-  if (inflateInit2(&stream, 16 + MAX_WBITS) != Z_OK) fail(name, "cannot initialise gzip decoder");
-  std::string out;
-  out.resize(std::min<std::uint64_t>(std::max<std::size_t>(compressed.size() * 4, 1 << 16), max_bytes));
-  stream.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(compressed.data()));
-  std::size_t consumed = 0;
-  std::size_t produced = 0;
-  for (;;) {
-    const std::size_t in_chunk = std::min<std::size_t>(compressed.size() - consumed, 1u << 30);
-    stream.avail_in = static_cast<uInt>(in_chunk);
-    if (produced == out.size()) {
-      if (out.size() >= max_bytes) {
-        inflateEnd(&stream);
-        fail(name, fmt::format("gzip data decompresses to more than {} bytes", max_bytes));
-      }
-      out.resize(std::min<std::uint64_t>(out.size() * 2, max_bytes));
-    }
-    const std::size_t out_chunk = std::min<std::size_t>(out.size() - produced, 1u << 30);
-    stream.next_out = reinterpret_cast<Bytef*>(out.data() + produced);
-    stream.avail_out = static_cast<uInt>(out_chunk);
-    const int rc = inflate(&stream, Z_NO_FLUSH);
-    consumed += in_chunk - stream.avail_in;
-    produced += out_chunk - stream.avail_out;
-    if (rc == Z_STREAM_END) {
-      if (consumed < compressed.size() && has_gzip_magic(compressed.substr(consumed))) {
-        inflateReset(&stream);  // another gzip member follows
-        continue;
-      }
-      break;
-    }
-    if (rc == Z_BUF_ERROR && consumed == compressed.size()) {
-      inflateEnd(&stream);
-      fail(name, "truncated gzip data");
-    }
-    if (rc != Z_OK && rc != Z_BUF_ERROR) {
-      const std::string why = stream.msg ? stream.msg : "corrupt data";
-      inflateEnd(&stream);
-      fail(name, "invalid gzip data (" + why + ")");
-    }
-  }
-  inflateEnd(&stream);
-  out.resize(produced);
   return out;
 }
 
@@ -242,9 +200,11 @@ Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& repor
     if (size < 3) fail(name, fmt::format("face {} has {} vertices; a face needs at least 3", p, size));
     for (auto c = soup.offsets[static_cast<std::size_t>(p)]; c < soup.offsets[static_cast<std::size_t>(p) + 1]; ++c) {
       const Index v = soup.corners[static_cast<std::size_t>(c)];
+      // In 64 bits: the file's own numbering of vertex 2^31-1 does not fit an Index.
       if (v < 0 || v >= nv64)
         fail(name, fmt::format("face {} references vertex {}, but the file has {} vertices (valid: {}..{})", p,
-                               v + soup.index_base, nv64, soup.index_base, nv64 - 1 + soup.index_base));
+                               std::int64_t{v} + soup.index_base, nv64, soup.index_base,
+                               nv64 - 1 + soup.index_base));
     }
   }
   if (soup.weld_vertices) weld_identical_vertices(soup, report);
@@ -314,8 +274,11 @@ Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& repor
   mesh.V = Eigen::Map<const Vertices>(soup.xyz.data(), nv, 3);
   const double diagonal = bounding_box(mesh.V).diagonal();
   // Geometry squares lengths twice (areas from squared cross products), so sizes beyond this
-  // range overflow to inf or underflow to 0; real meshes are nowhere near it.
-  if (!(diagonal <= kMaxDiagonal) || (diagonal > 0 && diagonal < kMinDiagonal))
+  // range overflow to inf or underflow to 0; real meshes are nowhere near it. A zero diagonal
+  // (every vertex at one point, or coordinates so small that it underflows) has no geometry to
+  // work on: it would also disable the zero-area filter below, which is relative to it.
+  if (diagonal == 0) fail(name, "all vertices are at the same point (the bounding box has zero size)");
+  if (!(diagonal <= kMaxDiagonal && diagonal >= kMinDiagonal))
     fail(name, fmt::format("bounding-box diagonal {:g} is outside the supported range [{:g}, {:g}]", diagonal,
                            kMinDiagonal, kMaxDiagonal));
   const double min_area = kDegenerateAreaRelative * diagonal * diagonal;
@@ -408,11 +371,28 @@ MeshFormat format_from_path(const std::filesystem::path& path) {
                               : "unknown extension '" + ext + "'; expected .obj, .ply, .off or .stl (optionally .gz)");
 }
 
+namespace {
+
+const char* format_name(MeshFormat format) {
+  switch (format) {
+    case MeshFormat::Obj: return "OBJ";
+    case MeshFormat::Ply: return "PLY";
+    case MeshFormat::Off: return "OFF";
+    case MeshFormat::Stl: return "STL";
+  }
+  return "?";
+}
+
+}  // namespace
+
 std::vector<std::string> ReadReport::warnings() const {
   std::vector<std::string> out;
   auto add = [&](std::int64_t count, const char* what) {
     if (count > 0) out.push_back(fmt::format("{} {}", count, what));
   };
+  if (format_differs_from_extension)
+    out.push_back(fmt::format("the file's content is {}, not what its extension says; read as {}",
+                              format_name(format), format_name(format)));
   add(polygons_triangulated, "polygons triangulated");
   add(polygons_fanned, "polygons had no planar triangulation (self-intersecting or folded) and were fanned");
   add(vertices_welded, "duplicate vertices welded");
@@ -423,41 +403,107 @@ std::vector<std::string> ReadReport::warnings() const {
   return out;
 }
 
+namespace {
+
+// The format the first bytes show, when they show one beyond doubt: "ply" on the first line, an
+// OFF keyword as the first token, or "solid" followed by "facet"/"endsolid" (ASCII STL). OBJ
+// has no signature. Binary STL is recognised by its size (84 + 50 x its triangle count).
+std::optional<MeshFormat> format_from_content(std::string_view head, bool complete, std::size_t total) {
+  if (head.substr(0, 4) == "ply\n" || head.substr(0, 5) == "ply\r\n") return MeshFormat::Ply;
+  const std::string no_name;
+  io_detail::TextScanner in(head, no_name);
+  const std::string_view first = in.token(/*comments=*/true);
+  static constexpr std::string_view off_keywords[] = {"OFF",   "COFF",   "NOFF",   "CNOFF",
+                                                      "STOFF", "STCOFF", "STNOFF", "STCNOFF"};
+  if (std::find(std::begin(off_keywords), std::end(off_keywords), first) != std::end(off_keywords))
+    return MeshFormat::Off;
+  if (first == "solid" && head.find('\0') == std::string_view::npos) {
+    in.skip_line();
+    const std::string_view second = in.token();
+    if (second == "facet" || second == "endsolid") return MeshFormat::Stl;
+  }
+  if (complete && total >= 84) {
+    std::uint32_t count = 0;
+    std::memcpy(&count, head.data() + 80, 4);
+    if (!io_detail::host_is_little_endian()) count = __builtin_bswap32(count);
+    if (84 + 50 * std::uint64_t{count} == total) return MeshFormat::Stl;
+  }
+  return std::nullopt;
+}
+
+Mesh read_mesh_checked(std::string_view bytes, MeshFormat format, const std::string& name, ReadReport& r,
+                       const ReadOptions& options) {
+  r = ReadReport{};
+  r.format = format;
+  io_detail::PolygonSoup soup;
+  {
+    io_detail::ByteSource source(bytes, name, {options.max_inflate_ratio, options.inflate_floor_bytes});
+    r.gzip = source.is_gzip();
+    // The first bytes decide what the file is, before any bulk is read or inflated.
+    constexpr std::size_t kHeadBytes = 4096;
+    source.request(kHeadBytes, 0);
+    const std::string_view head = source.data().substr(0, kHeadBytes);
+    if (head.empty()) io_detail::fail(name, "the file is empty");
+    const std::optional<MeshFormat> content = format_from_content(head, source.complete(), source.data().size());
+    if (content && *content != format) {
+      r.format = *content;
+      r.format_differs_from_extension = true;
+    } else if (!content && format == MeshFormat::Obj && head.find('\0') != std::string_view::npos) {
+      io_detail::fail(name, "not an OBJ file (it holds binary data, and OBJ is text)");
+    }
+    switch (r.format) {
+      case MeshFormat::Obj:
+        soup = io_detail::parse_obj(source, name);
+        break;
+      case MeshFormat::Ply:
+        soup = io_detail::parse_ply(source, name, r);
+        break;
+      case MeshFormat::Off:
+        soup = io_detail::parse_off(source, name, r);
+        break;
+      case MeshFormat::Stl:
+        soup = io_detail::parse_stl(source, name, r);
+        break;
+    }
+    source.verify_rest();
+  }  // the text is freed before the mesh is built
+  return io_detail::soup_to_mesh(std::move(soup), name, r, options);
+}
+
+}  // namespace
+
+double default_max_inflate_ratio() {
+  // Read once: the environment does not change under a running program in any way we support.
+  static const double ratio = [] {
+    const char* text = std::getenv("VERTEXFLOW_MAX_INFLATE_RATIO");
+    if (text == nullptr) return 32.0;
+    char* end = nullptr;
+    const double value = std::strtod(text, &end);
+    return end != text && *end == '\0' && value > 0 ? value : 32.0;
+  }();
+  return ratio;
+}
+
 Mesh read_mesh_from_memory(std::string_view bytes, MeshFormat format, const std::string& name, ReadReport* report,
                            const ReadOptions& options) {
   ReadReport local;
-  ReadReport& r = report ? *report : local;
-  r = ReadReport{};
-  r.format = format;
-  std::string inflated;
-  if (io_detail::has_gzip_magic(bytes)) {
-    inflated = io_detail::gunzip(bytes, name, options.max_decompressed_bytes);
-    bytes = inflated;
-    r.gzip = true;
+  try {
+    return read_mesh_checked(bytes, format, name, report ? *report : local, options);
+  } catch (const std::bad_alloc&) {
+    io_detail::fail(name, "out of memory while reading the mesh");
+  } catch (const std::length_error&) {
+    io_detail::fail(name, "out of memory while reading the mesh (a size beyond what a vector can hold)");
   }
-  if (bytes.empty()) io_detail::fail(name, "the file is empty");
-  io_detail::PolygonSoup soup;
-  switch (format) {
-    case MeshFormat::Obj:
-      soup = io_detail::parse_obj(bytes, name);
-      break;
-    case MeshFormat::Ply:
-      soup = io_detail::parse_ply(bytes, name, r);
-      break;
-    case MeshFormat::Off:
-      soup = io_detail::parse_off(bytes, name, r);
-      break;
-    case MeshFormat::Stl:
-      soup = io_detail::parse_stl(bytes, name, r);
-      break;
-  }
-  inflated = std::string();  // free the text before building the mesh
-  return io_detail::soup_to_mesh(std::move(soup), name, r, options);
 }
 
 Mesh read_mesh(const std::filesystem::path& path, ReadReport* report, const ReadOptions& options) {
   const MeshFormat format = format_from_path(path);
-  const io_detail::FileBytes bytes = io_detail::read_file_bytes(path);
+  io_detail::FileBytes bytes;
+  try {
+    bytes = io_detail::read_file_bytes(path);
+  } catch (const std::bad_alloc&) {
+    io_detail::fail(path.string(), "out of memory while loading the file");
+  }
   return read_mesh_from_memory(bytes.view(), format, path.string(), report, options);
 }
 

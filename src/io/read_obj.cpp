@@ -11,15 +11,15 @@
 
 namespace vertexflow::io_detail {
 
-PolygonSoup parse_obj(std::string_view bytes, const std::string& name) {
+PolygonSoup parse_obj(ByteSource& source, const std::string& name) {
   PolygonSoup soup;
   soup.index_base = 1;
-  TextScanner in(bytes, name);
+  TextScanner in(source, name);
   // Positive indices may refer to vertices defined later in the file, so they are resolved
   // and range-checked once the whole file is read (soup_to_mesh).
   while (!in.at_end()) {
     in.skip_blanks();
-    const std::string_view rest = in.rest();
+    const std::string_view rest = in.lookahead(2);
     if (rest.size() >= 2 && rest[0] == 'v' && (rest[1] == ' ' || rest[1] == '\t')) {
       in.advance(1);
       double xyz[3];

@@ -30,7 +30,7 @@ OffHeader parse_keyword(std::string_view keyword, const std::string& name) {
   return h;
 }
 
-void check_counts(std::int64_t nv, std::int64_t nf, std::size_t available, std::size_t vertex_bytes,
+void check_counts(std::int64_t nv, std::int64_t nf, std::uint64_t available, std::size_t vertex_bytes,
                   std::size_t face_bytes, const std::string& name) {
   if (nv < 0 || nf < 0) fail(name, fmt::format("negative element count in header ({} vertices, {} faces)", nv, nf));
   const auto fits = static_cast<std::uint64_t>(nv) * vertex_bytes + static_cast<std::uint64_t>(nf) * face_bytes;
@@ -117,27 +117,29 @@ PolygonSoup parse_binary(std::string_view bytes, std::size_t start, const OffHea
 
 }  // namespace
 
-PolygonSoup parse_off(std::string_view bytes, const std::string& name, ReadReport& report) {
-  TextScanner in(bytes, name);
+PolygonSoup parse_off(ByteSource& source, const std::string& name, ReadReport& report) {
+  TextScanner in(source, name);
   const OffHeader keyword = parse_keyword(in.token(/*comments=*/true), name);
   OffHeader h = keyword;
   // "OFF BINARY" on the first line switches to the binary layout after that line.
   in.skip_blanks();
-  if (in.rest().substr(0, 6) == "BINARY") {
+  if (in.lookahead(6) == "BINARY") {
     in.advance(6);
     in.skip_line();
     h.binary = true;
     report.binary = true;
-    return parse_binary(bytes, in.position(), h, name);
+    // The layout is chosen by which one reads the whole file exactly, so it needs the size.
+    source.request_all();
+    return parse_binary(source.data(), in.position() - source.offset(), h, name);
   }
   const std::int64_t nv = in.next_int("the vertex count", true);
   const std::int64_t nf = in.next_int("the face count", true);
   if (!in.at_line_end()) in.token_on_line();  // the edge count, unused
   in.skip_line();
   // Shortest records: "0 0 0\n" for a vertex, "3 0 1 2\n" for a face.
-  check_counts(nv, nf, in.remaining(), 6, 8, name);
+  check_counts(nv, nf, in.remaining_bound(), 6, 8, name);
   PolygonSoup soup;
-  soup.xyz.reserve(3 * static_cast<std::size_t>(nv));
+  soup.xyz.reserve(3 * static_cast<std::size_t>(nv));  // resident only as vertices fill it (read_ply.cpp)
   for (std::int64_t v = 0; v < nv; ++v) {
     const double x = in.next_double("a vertex coordinate", true);
     const double y = in.next_double("a vertex coordinate", true);
@@ -148,7 +150,7 @@ PolygonSoup parse_off(std::string_view bytes, const std::string& name, ReadRepor
   soup.offsets.reserve(static_cast<std::size_t>(nf) + 1);
   for (std::int64_t f = 0; f < nf; ++f) {
     const std::int64_t n = in.next_int("a face's vertex count", true);
-    if (n < 0 || static_cast<std::uint64_t>(n) > in.remaining() / 2 + 1)
+    if (n < 0 || static_cast<std::uint64_t>(n) > in.remaining_bound() / 2 + 1)
       in.error(fmt::format("face {} declares {} vertices, more than the file holds", f, n));
     for (std::int64_t k = 0; k < n; ++k) {
       const std::int64_t index = in.next_int("a face vertex index");

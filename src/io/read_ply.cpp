@@ -76,8 +76,8 @@ enum class Role { X, Y, Z, Red, Green, Blue, Scalar, Skip };
 
 class PlyParser {
  public:
-  PlyParser(std::string_view bytes, const std::string& name, ReadReport& report)
-      : bytes_(bytes), name_(name), report_(report) {}
+  PlyParser(ByteSource& source, const std::string& name, ReadReport& report)
+      : source_(source), name_(name), report_(report) {}
 
   PolygonSoup parse() {
     parse_header();
@@ -96,7 +96,7 @@ class PlyParser {
  private:
   void parse_header() {
     const std::size_t header_end = find_end_header();
-    TextScanner header(bytes_.substr(0, header_end), name_);
+    TextScanner header(source_.data().substr(0, header_end), name_);
     if (header.token_on_line() != "ply") fail(name_, "not a PLY file (first line must be 'ply')");
     header.skip_line();
     bool have_format = false;
@@ -156,19 +156,31 @@ class PlyParser {
       fail(name_, "PLY header declares no face element (point clouds are not meshes)");
   }
 
-  // Returns the offset just past the "end_header" line and positions the body there.
+  // Returns the offset just past the "end_header" line and positions the body there. Reads
+  // the header line by line from the source, so a stream that is no PLY fails at once.
   std::size_t find_end_header() {
-    if (bytes_.substr(0, 3) != "ply") fail(name_, "not a PLY file (first line must be 'ply')");
+    source_.request(3, 0);
+    if (source_.data().substr(0, 3) != "ply") fail(name_, "not a PLY file (first line must be 'ply')");
     std::size_t pos = 0;
-    while (pos < bytes_.size()) {
-      std::size_t nl = bytes_.find('\n', pos);
-      if (nl == std::string_view::npos) nl = bytes_.size();
-      std::string_view line = bytes_.substr(pos, nl - pos);
+    for (;;) {
+      std::size_t nl = source_.data().find('\n', pos);
+      while (nl == std::string_view::npos) {
+        const std::size_t searched = source_.data().size();
+        if (!source_.request(searched + 1, 0)) break;  // the header is kept for parse_header
+        nl = source_.data().find('\n', searched);
+      }
+      const std::string_view bytes = source_.data();
+      if (pos >= bytes.size()) break;
+      if (nl == std::string_view::npos) nl = bytes.size();
+      std::string_view line = bytes.substr(pos, nl - pos);
       if (!line.empty() && line.back() == '\r') line.remove_suffix(1);
       if (line == "end_header" || line.substr(0, 11) == "end_header ") {
-        body_ = std::min(nl + 1, bytes_.size());
+        body_ = std::min(nl + 1, bytes.size());
         return body_;
       }
+      // A header is text; binary data before end_header means this is no PLY header (or a
+      // stream that would make us scan far for a line that never comes).
+      if (line.find('\0') != std::string_view::npos) fail(name_, "not a PLY file (binary data in the header)");
       pos = nl + 1;
     }
     fail(name_, "PLY header has no end_header line (truncated file?)");
@@ -186,20 +198,20 @@ class PlyParser {
 
   void check_count(const Element& element) const {
     const std::uint64_t min_bytes = min_record_bytes(element);
-    const std::uint64_t available = bytes_.size() - body_;
+    const std::uint64_t available = source_.size_bound() - body_;
     // ASCII: the last record needs no trailing separator, hence the extra byte.
     const std::uint64_t capacity = min_bytes == 0 ? 0 : (encoding_ == Encoding::Ascii ? available + 1 : available) / min_bytes;
     if (min_bytes > 0 && element.count > capacity)
-      fail(name_, fmt::format("header declares {} '{}' elements, but the remaining {} bytes can hold at most {}",
-                              element.count, element.name, available, capacity));
+      fail(name_, fmt::format("header declares {} '{}' elements, but the remaining {} bytes{} can hold at most {}",
+                              element.count, element.name, available,
+                              source_.complete() ? "" : " (the gzip inflation limit)", capacity));
   }
 
   // --- value access: ASCII tokens or binary bytes, advancing body_ ---
   double next_value(Type type, const char* what) {
     if (encoding_ == Encoding::Ascii) return ascii_value(what);
     const std::size_t size = type_size(type);
-    if (body_ + size > bytes_.size()) truncated(what);
-    const double v = load_as<double>(bytes_.data() + body_, type, swap_);
+    const double v = load_as<double>(binary_bytes(size, what), type, swap_);
     body_ += size;
     return v;
   }
@@ -210,14 +222,13 @@ class PlyParser {
       return static_cast<std::int64_t>(v);
     }
     const std::size_t size = type_size(type);
-    if (body_ + size > bytes_.size()) truncated(what);
-    const std::int64_t v = load_as<std::int64_t>(bytes_.data() + body_, type, swap_);
+    const std::int64_t v = load_as<std::int64_t>(binary_bytes(size, what), type, swap_);
     body_ += size;
     return v;
   }
   std::uint64_t next_list_count(const Property& p) {
     const std::int64_t n = next_integer(p.count_type, "list length");
-    const std::uint64_t available = bytes_.size() - position();
+    const std::uint64_t available = source_.size_bound() - position();
     const std::uint64_t item = encoding_ == Encoding::Ascii ? 2 : type_size(p.type);
     if (n < 0 || static_cast<std::uint64_t>(n) > (available + 1) / item)
       fail(name_, fmt::format("invalid list length {} for property '{}' at byte {}", n, p.name, position()));
@@ -230,6 +241,11 @@ class PlyParser {
     }
     const std::uint64_t n = next_list_count(p);
     for (std::uint64_t i = 0; i < n; ++i) next_value(p.type, "a list item");
+  }
+  // The next `size` bytes of a binary body; what lies before them may be dropped.
+  const char* binary_bytes(std::size_t size, const char* what) {
+    if (!source_.request(body_ + size, body_)) truncated(what);
+    return source_.data().data() + (body_ - source_.offset());
   }
   [[noreturn]] void truncated(const char* what) const {
     fail(name_, fmt::format("unexpected end of file while reading {} (file truncated?)", what));
@@ -253,7 +269,7 @@ class PlyParser {
   }
   TextScanner& ascii() {
     if (!scanner_) {
-      scanner_.emplace(bytes_, name_);
+      scanner_.emplace(source_, name_);
       scanner_->advance(body_);
     }
     return *scanner_;
@@ -281,24 +297,27 @@ class PlyParser {
       roles.push_back(role);
     }
     if (!has[0] || !has[1] || !has[2]) fail(name_, "vertex element lacks an x, y or z property");
-    const std::size_t n = static_cast<std::size_t>(element.count);
-    soup_.xyz.resize(3 * n);
-    if (color_channels == 3) soup_.rgb.resize(3 * n);
+    // The count is bounded by the bytes the input can hold (check_count; for gzip, by the
+    // inflation limit). Reserved pages become resident only as records fill them, so a gzip
+    // header's claim costs address space, not memory, until the content backs it.
+    const std::uint64_t n = element.count;
+    const auto expected = static_cast<std::size_t>(n);
+    soup_.xyz.reserve(3 * expected);
+    if (color_channels == 3) soup_.rgb.reserve(3 * expected);
+    std::vector<std::vector<double>> scalars;
     for (std::size_t i = 0; i < element.properties.size(); ++i) {
-      if (roles[i] == Role::Scalar) {
-        scalar_slot.push_back(soup_.properties.size());
-        soup_.properties.push_back({element.properties[i].name, Eigen::VectorXd(static_cast<Eigen::Index>(n))});
-      } else {
-        scalar_slot.push_back(0);
-      }
+      scalar_slot.push_back(scalars.size());
+      if (roles[i] == Role::Scalar) scalars.emplace_back().reserve(expected);
     }
-    for (std::size_t v = 0; v < n; ++v) {
+    for (std::uint64_t v = 0; v < n; ++v) {
       begin_record();
+      double xyz[3] = {0, 0, 0};
+      std::uint8_t rgb[3] = {0, 0, 0};
       for (std::size_t i = 0; i < element.properties.size(); ++i) {
         const Property& p = element.properties[i];
         switch (roles[i]) {
           case Role::X: case Role::Y: case Role::Z:
-            soup_.xyz[3 * v + static_cast<std::size_t>(roles[i])] = next_value(p.type, "a vertex coordinate");
+            xyz[static_cast<std::size_t>(roles[i])] = next_value(p.type, "a vertex coordinate");
             break;
           case Role::Red: case Role::Green: case Role::Blue: {
             const double c = next_value(p.type, "a vertex colour");
@@ -306,18 +325,27 @@ class PlyParser {
             // outside 0..255 (or NaN) to uint8 is undefined behaviour. (Found by fuzz_read_ply.)
             if (encoding_ == Encoding::Ascii && !(c >= 0 && c <= 255))
               ascii().error(fmt::format("vertex colour {} is outside 0..255", c));
-            if (!soup_.rgb.empty()) soup_.rgb[3 * v + static_cast<std::size_t>(roles[i]) - 3] = static_cast<std::uint8_t>(c);
+            rgb[static_cast<std::size_t>(roles[i]) - 3] = static_cast<std::uint8_t>(c);
             break;
           }
           case Role::Scalar:
-            soup_.properties[scalar_slot[i]].values[static_cast<Eigen::Index>(v)] = next_value(p.type, "a vertex property");
+            scalars[scalar_slot[i]].push_back(next_value(p.type, "a vertex property"));
             break;
           case Role::Skip:
             skip_property(p);
             break;
         }
       }
+      soup_.add_vertex(xyz[0], xyz[1], xyz[2]);
+      if (color_channels == 3) soup_.rgb.insert(soup_.rgb.end(), rgb, rgb + 3);
       end_record(element);
+    }
+    for (std::size_t i = 0; i < element.properties.size(); ++i) {
+      if (roles[i] != Role::Scalar) continue;
+      const std::vector<double>& values = scalars[scalar_slot[i]];
+      soup_.properties.push_back(
+          {element.properties[i].name,
+           Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()))});
     }
     sync_ascii();
   }
@@ -333,10 +361,11 @@ class PlyParser {
       fail(name_, "face element has no 'vertex_indices' list property");
     if (!is_integer(element.properties[index_property].type))
       fail(name_, "face vertex indices must have an integer type");
-    const std::size_t n = static_cast<std::size_t>(element.count);
-    soup_.offsets.reserve(n + 1);
-    soup_.corners.reserve(3 * n);
-    for (std::size_t f = 0; f < n; ++f) {
+    const std::uint64_t n = element.count;
+    const auto expected = static_cast<std::size_t>(n);  // bounded as in read_vertices
+    soup_.offsets.reserve(expected + 1);
+    soup_.corners.reserve(3 * expected);
+    for (std::uint64_t f = 0; f < n; ++f) {
       begin_record();
       for (std::size_t i = 0; i < element.properties.size(); ++i) {
         const Property& p = element.properties[i];
@@ -376,7 +405,7 @@ class PlyParser {
     if (scanner_) body_ = scanner_->position();
   }
 
-  std::string_view bytes_;
+  ByteSource& source_;
   const std::string& name_;
   ReadReport& report_;
   std::vector<Element> elements_;
@@ -389,8 +418,8 @@ class PlyParser {
 
 }  // namespace
 
-PolygonSoup parse_ply(std::string_view bytes, const std::string& name, ReadReport& report) {
-  return PlyParser(bytes, name, report).parse();
+PolygonSoup parse_ply(ByteSource& source, const std::string& name, ReadReport& report) {
+  return PlyParser(source, name, report).parse();
 }
 
 }  // namespace vertexflow::io_detail

@@ -14,16 +14,19 @@ namespace {
 constexpr std::size_t kBinaryHeader = 84;  // 80-byte comment + uint32 triangle count
 constexpr std::size_t kBinaryRecord = 50;  // normal, 3 corners (float32 x 12), uint16 attribute
 
+// ASCII STL starts with "solid", but so do many binary files' 80-byte comments. A binary file
+// matches its declared size exactly, and its records hold NUL bytes (zero coordinates, the
+// attribute count), which text never does: both say binary, so that a binary file with a
+// "solid" comment and a stray trailing byte is read as binary, not as empty text.
 bool looks_ascii(std::string_view bytes) {
   std::size_t i = 0;
   while (i < bytes.size() && TextScanner::is_space(bytes[i])) ++i;
   if (bytes.substr(i, 5) != "solid") return false;
-  // Binary files whose comment starts with "solid" still match their declared size exactly.
   if (bytes.size() >= kBinaryHeader) {
     const std::uint64_t count = load_scalar<std::uint32_t>(bytes.data() + 80, !host_is_little_endian());
     if (kBinaryHeader + count * kBinaryRecord == bytes.size()) return false;
   }
-  return true;
+  return bytes.substr(0, 4096).find('\0') == std::string_view::npos;
 }
 
 PolygonSoup parse_ascii(std::string_view bytes, const std::string& name) {
@@ -91,7 +94,10 @@ PolygonSoup parse_binary(std::string_view bytes, const std::string& name) {
 
 }  // namespace
 
-PolygonSoup parse_stl(std::string_view bytes, const std::string& name, ReadReport& report) {
+PolygonSoup parse_stl(ByteSource& source, const std::string& name, ReadReport& report) {
+  // ASCII or binary is decided with the total size (a binary file matches its declared size).
+  source.request_all();
+  const std::string_view bytes = source.data();
   if (looks_ascii(bytes)) {
     PolygonSoup soup = parse_ascii(bytes, name);
     soup.weld_vertices = true;

@@ -21,7 +21,8 @@ inline int read_one(const std::uint8_t* data, std::size_t size, MeshFormat forma
   // Keep gzip inputs from inflating to gigabytes: scripts/fuzz.sh runs with
   // -malloc_limit_mb=512, so that any single allocation that large (from at most 64 kB of input,
   // or 16 MB once inflated) is reported as a header count that was trusted.
-  options.max_decompressed_bytes = std::uint64_t{16} << 20;
+  options.inflate_floor_bytes = std::uint64_t{16} << 20;
+  options.max_inflate_ratio = 0;  // the floor alone: 16 MB whatever the input size
   try {
     const Mesh mesh = read_mesh_from_memory(bytes, format, "fuzz", nullptr, options);
     // A mesh that was accepted must be consistent: every face index names a vertex.
