@@ -54,7 +54,8 @@ constexpr char kFlippedOrDegenerate = 1, kLowQuality = 2;
 char face_badness(const GuardCriteria& criteria, const Vertices& after, Index f) {
   const Faces& F = criteria.F;
   const Eigen::Vector3d n0 = face_normal(criteria.before, F, f), n1 = face_normal(after, F, f);
-  if (0.5 * n0.norm() < criteria.min_area) return 0;
+  // Written as !(>) so that a zero-area face is never judged, even where min_area is 0.
+  if (!(0.5 * n0.norm() > criteria.min_area)) return 0;
   if (n0.dot(n1) <= 0 || 0.5 * n1.norm() < criteria.min_area) return kFlippedOrDegenerate;
   const Eigen::Vector3d a = after.row(F(f, 0)), b = after.row(F(f, 1)), c = after.row(F(f, 2));
   return triangle_quality(a, b, c) < criteria.quality_floor[f] ? kLowQuality : 0;
@@ -85,7 +86,9 @@ void guard(Vertices& X, const Vertices& anchor, const Vertices& input, const Gua
   report.low_quality_before_guard += static_cast<Index>(std::count(bad.begin(), bad.end(), kLowQuality));
   // Each round halves every free vertex of a bad face once; after max_halvings rounds their
   // displacement is zero, and a face whose vertices are all back at the anchor is not bad. Only
-  // the faces around the vertices a round moved are judged again.
+  // the faces around the vertices a round moved are judged again. The loop ends when a round
+  // changes no step: steps only ever shrink, through at most max_halvings values each, so the
+  // loop is finite whatever the geometry, even if rounding left a face bad at its anchor.
   std::vector<char> touched(static_cast<std::size_t>(n), 0);
   std::vector<Index> bad_list;
   for (Index f = 0; f < F.rows(); ++f) {
@@ -103,10 +106,13 @@ void guard(Vertices& X, const Vertices& anchor, const Vertices& input, const Gua
       }
     }
     std::sort(moved.begin(), moved.end());
+    bool any_step_changed = false;
     for (const Index i : moved) {
       const auto v = static_cast<std::size_t>(i);
       touched[v] = 0;
-      step[v] = round >= options.max_halvings ? 0.0 : 0.5 * step[v];
+      const double new_step = round >= options.max_halvings ? 0.0 : 0.5 * step[v];
+      any_step_changed = any_step_changed || new_step != step[v];
+      step[v] = new_step;
       shortened[v] = 1;
       X.row(i) = anchor.row(i) + step[v] * displacement.row(i);
       // Back onto the surface, except at step 0: the anchor itself, exactly.
@@ -128,6 +134,7 @@ void guard(Vertices& X, const Vertices& anchor, const Vertices& input, const Gua
     }
     // Bad faces away from the moved vertices cannot exist: they were bad before and so had all
     // their free vertices moved (or all fixed, and then they are at the anchor and not bad).
+    if (!any_step_changed) break;
   }
 }
 
@@ -171,6 +178,12 @@ std::vector<Index> degenerate_faces(const Vertices& V, const Faces& F) {
 FlowResult vertex_flow(const Vertices& V, const Faces& F, const FlowOptions& options) {
   const Index n = static_cast<Index>(V.rows());
   if (n == 0 || F.rows() == 0) throw std::invalid_argument("vertex flow: the mesh is empty");
+  if (!V.allFinite()) throw std::invalid_argument("vertex flow: a vertex has a non-finite coordinate");
+  // The flow normalises by the mean edge length and judges faces relative to the diagonal; a
+  // mesh without extent has neither.
+  if (!(bounding_box(V).diagonal() > 0))
+    throw std::invalid_argument(
+        "vertex flow: the bounding box has zero size (all vertices at one point, or coordinates too small to compute with)");
   if (!(options.d_percentile >= 0 && options.d_percentile <= 100))
     throw std::invalid_argument("vertex flow: d_percentile must be in [0, 100]");
   if (options.max_halvings < 1) throw std::invalid_argument("vertex flow: max_halvings must be at least 1");

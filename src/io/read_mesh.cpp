@@ -277,7 +277,8 @@ Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& repor
   // range overflow to inf or underflow to 0; real meshes are nowhere near it. A zero diagonal
   // (every vertex at one point, or coordinates so small that it underflows) has no geometry to
   // work on: it would also disable the zero-area filter below, which is relative to it.
-  if (diagonal == 0) fail(name, "all vertices are at the same point (the bounding box has zero size)");
+  if (diagonal == 0)
+    fail(name, "the bounding box has zero size (all vertices at one point, or coordinates too small to compute with)");
   if (!(diagonal <= kMaxDiagonal && diagonal >= kMinDiagonal))
     fail(name, fmt::format("bounding-box diagonal {:g} is outside the supported range [{:g}, {:g}]", diagonal,
                            kMinDiagonal, kMaxDiagonal));

@@ -44,9 +44,13 @@ Mesh run(SurfaceMesh mesh, double edge_length, const IsotropicRemeshOptions& opt
 // sqrt(1.16) longer saves a run in most cases; the search corrects what remains.
 constexpr double kLengthFactor = 1.077;
 
+// The area the vertex estimates divide; zero (a mesh collapsed to a point or a line) would
+// turn them into 0/0.
 double surface_area(const Vertices& V, const Faces& F) {
   double area = 0;
   for (Index f = 0; f < F.rows(); ++f) area += face_area(V, F, f);
+  if (!(area > 0) || !std::isfinite(area))
+    throw std::invalid_argument(fmt::format("remesh: the mesh's surface area is {:g}; there is nothing to remesh", area));
   return area;
 }
 

@@ -11,6 +11,9 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
+#include <cstdlib>
+#include <future>
 #include <iostream>
 #include <limits>
 
@@ -297,6 +300,31 @@ TEST(Flow, FacesDegenerateInTheInputDoNotStallTheGuard) {
   const FlowResult result = vertex_flow(mesh.V, mesh.F);
   EXPECT_TRUE(flipped_faces(mesh.V, result.V, mesh.F).empty());
   EXPECT_GT(mean_displacement(result.V.topRows(n), mesh.V.topRows(n)), 0.0);
+}
+
+TEST(Flow, AMeshWithoutExtentIsRefusedInsteadOfLoopedOn) {
+  // Issue 12: a closed tetrahedron with its four vertices at one point (or at coordinates whose
+  // squares underflow) made the guard loop forever. Each call runs under a watchdog.
+  const Faces F = (Faces(4, 3) << 0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3).finished();
+  for (const double scale : {0.0, 1e-170}) {
+    SCOPED_TRACE(scale);
+    Vertices V(4, 3);
+    V << 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1, 1;
+    if (scale > 0) V = (Vertices(4, 3) << 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1).finished() * scale;
+    auto outcome = std::async(std::launch::async, [&] {
+      try {
+        vertex_flow(V, F);
+        return std::string("accepted");
+      } catch (const std::invalid_argument& e) {
+        return std::string(e.what());
+      }
+    });
+    if (outcome.wait_for(std::chrono::seconds(60)) == std::future_status::timeout) {
+      ADD_FAILURE() << "vertex_flow still running after 60 s (it takes milliseconds when it refuses)";
+      std::_Exit(1);  // the hung thread cannot be joined
+    }
+    EXPECT_NE(outcome.get().find("the bounding box has zero size"), std::string::npos);
+  }
 }
 
 }  // namespace

@@ -395,6 +395,33 @@ TEST(BadInput, GzipBombStopsAtTheInflationLimit) {
 
 // --- cases made at test time ----------------------------------------------------------------
 
+TEST(BadInput, AMeshWithoutExtentIsRefused) {
+  // Issue 12's reproducer (four identical vertices), and distinct coordinates so small that the
+  // bounding box's diagonal underflows to 0: both once went on to hang `enhance`.
+  for (const char* obj : {"v 1 1 1\nv 1 1 1\nv 1 1 1\nv 1 1 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n",
+                          "v 0 0 0\nv 1e-170 0 0\nv 0 1e-170 0\nv 0 0 1e-170\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n"}) {
+    try {
+      read_mesh_from_memory(obj, MeshFormat::Obj, "point.obj");
+      ADD_FAILURE() << "accepted: " << obj;
+    } catch (const IoError& e) {
+      EXPECT_STREQ(e.what(),
+                   "point.obj: the bounding box has zero size (all vertices at one point, or coordinates too small "
+                   "to compute with)");
+    }
+  }
+}
+
+TEST(BadInput, AFaceIndexOfTwoToThe31IsReportedAsTheFileWroteIt) {
+  // f 1 2 2147483648: the 1-based index 2^31 fits an Index once made 0-based, and adding the
+  // base back for the message overflowed (UBSan, fuzz_read_obj).
+  try {
+    read_mesh_from_memory("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 2147483648\n", MeshFormat::Obj, "big.obj");
+    ADD_FAILURE() << "accepted";
+  } catch (const IoError& e) {
+    EXPECT_STREQ(e.what(), "big.obj: face 0 references vertex 2147483648, but the file has 3 vertices (valid: 1..3)");
+  }
+}
+
 TEST(BadInput, Directory) {
   const ScratchDir scratch("bad-input-dir");
   const fs::path dir = scratch.file("dir.obj");

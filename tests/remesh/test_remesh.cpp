@@ -223,6 +223,17 @@ TEST(Remesh, RefusesBadInputAndOptions) {
   options.target_vertices = 100;
   options.max_attempts = 0;
   EXPECT_THROW(remesh_to_vertex_count(sphere.V, sphere.F, options), std::invalid_argument);
+  // A mesh collapsed to a point has no area to divide (issue 12: "about -nan vertices").
+  const Vertices point = Vertices::Zero(sphere.V.rows(), 3);
+  for (const bool by_count : {true, false}) {
+    try {
+      if (by_count) remesh_to_vertex_count(point, sphere.F);
+      else remesh_isotropic(point, sphere.F, 0.1);
+      FAIL() << "zero-area mesh accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("remesh: the mesh's surface area is 0"), std::string::npos) << e.what();
+    }
+  }
 }
 
 }  // namespace

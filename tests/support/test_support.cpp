@@ -4,8 +4,15 @@
 
 #include <gtest/gtest.h>
 
+#include <fcntl.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <csignal>
+#include <thread>
 #include <cctype>
 #include <cstdio>
 #include <fstream>
@@ -69,6 +76,57 @@ CommandResult run_command(const std::string& command) {
 
 CommandResult run_cli(const std::string& arguments) {
   return run_command(shell_quote(VERTEXFLOW_CLI) + " " + arguments);
+}
+
+WatchedRun run_cli_watched(const std::vector<std::string>& arguments, double timeout_seconds,
+                           const std::vector<std::string>& environment) {
+  ScratchDir scratch("watched");
+  const std::string err_path = scratch.file("stderr.txt").string();
+  // Everything the child needs is built before fork: between fork and exec only
+  // async-signal-safe calls are allowed (the parent may run TBB threads).
+  std::vector<std::string> argv_text{VERTEXFLOW_CLI};
+  argv_text.insert(argv_text.end(), arguments.begin(), arguments.end());
+  std::vector<char*> argv;
+  for (std::string& a : argv_text) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  std::vector<std::string> env_text;
+  for (char** e = environ; *e != nullptr; ++e) env_text.emplace_back(*e);
+  env_text.insert(env_text.end(), environment.begin(), environment.end());
+  std::vector<char*> envp;
+  for (std::string& e : env_text) envp.push_back(e.data());
+  envp.push_back(nullptr);
+
+  WatchedRun result;
+  const pid_t pid = ::fork();
+  if (pid < 0) return result;
+  if (pid == 0) {
+    const int fd = ::open(err_path.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fd >= 0) ::dup2(fd, 2);
+    const int null = ::open("/dev/null", O_WRONLY);
+    if (null >= 0) ::dup2(null, 1);
+    ::execve(argv[0], argv.data(), envp.data());
+    ::_exit(127);
+  }
+  const auto start = std::chrono::steady_clock::now();
+  int status = 0;
+  rusage usage{};
+  for (;;) {
+    const pid_t done = ::wait4(pid, &status, WNOHANG, &usage);
+    if (done == pid) break;
+    if (done < 0 && errno != EINTR) return result;
+    if (std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > timeout_seconds) {
+      ::kill(pid, SIGKILL);
+      while (::wait4(pid, &status, 0, &usage) < 0 && errno == EINTR) {
+      }
+      result.timed_out = true;
+      break;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  result.peak_rss_kb = usage.ru_maxrss;
+  result.err = read_text(err_path);
+  return result;
 }
 
 void expect_same_topology(const Mesh& input, const Mesh& output) {

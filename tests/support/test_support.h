@@ -5,6 +5,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace vertexflow::test {
 
@@ -47,6 +48,20 @@ CommandResult run_command(const std::string& command);
 
 /// Runs the built `vertexflow` CLI with `arguments` (already shell-quoted as needed).
 CommandResult run_cli(const std::string& arguments);
+
+/// What run_cli_watched saw of one run.
+struct WatchedRun {
+  int exit_code = -1;         ///< exit status, or -1 if the process died from a signal
+  bool timed_out = false;     ///< killed by the watchdog
+  std::string err;            ///< stderr
+  long peak_rss_kb = 0;       ///< the child's peak resident set (getrusage ru_maxrss)
+};
+
+/// Runs the CLI with `arguments` (not through a shell) and `environment` entries
+/// ("NAME=value") added to this process's environment. A watchdog kills it after
+/// `timeout_seconds` (a hang, not a speed check: give it ample time).
+WatchedRun run_cli_watched(const std::vector<std::string>& arguments, double timeout_seconds,
+                           const std::vector<std::string>& environment = {});
 
 /// Single-quotes a string for /bin/sh.
 std::string shell_quote(const std::string& s);

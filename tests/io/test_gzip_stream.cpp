@@ -1,0 +1,237 @@
+// gzip input is parsed as it is inflated (src/io/byte_source.h): the header is checked after the
+// first bytes, consumed bytes are dropped, and inflation is capped. The bombs are issue 12's:
+// each must end within the watchdog with one line naming the file, in under 300 MB.
+#include "byte_source.h"
+#include "io_internal.h"
+#include "test_support.h"
+#include "vertexflow/io.h"
+
+#include <gtest/gtest.h>
+#include <zlib.h>
+
+#include <fstream>
+#include <string>
+
+namespace vertexflow {
+namespace {
+
+namespace fs = std::filesystem;
+using test::ScratchDir;
+
+// One gzip member of `data` (windowBits 31: gzip wrapper). Members concatenate to one stream,
+// so a bomb is one member repeated.
+std::string gzip_member(std::string_view data, int level = 9) {
+  z_stream z{};
+  EXPECT_EQ(deflateInit2(&z, level, Z_DEFLATED, 31, 9, Z_DEFAULT_STRATEGY), Z_OK);
+  std::string out(deflateBound(&z, data.size()), '\0');
+  z.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data.data()));
+  z.avail_in = static_cast<uInt>(data.size());
+  z.next_out = reinterpret_cast<Bytef*>(out.data());
+  z.avail_out = static_cast<uInt>(out.size());
+  EXPECT_EQ(deflate(&z, Z_FINISH), Z_STREAM_END);
+  out.resize(z.total_out);
+  deflateEnd(&z);
+  return out;
+}
+
+void write_file(const fs::path& path, const std::string& first, const std::string& repeated, int times) {
+  std::ofstream out(path, std::ios::binary);
+  out << first;
+  for (int i = 0; i < times; ++i) out << repeated;
+}
+
+std::string ply_header(std::int64_t vertices) {
+  return "ply\nformat ascii 1.0\nelement vertex " + std::to_string(vertices) +
+         "\nproperty float x\nproperty float y\nproperty float z\nelement face 1\n"
+         "property list uchar int vertex_indices\nend_header\n";
+}
+
+// 16 MiB of vertex lines, compressed once (about 32 kB).
+const std::string& vertex_lines_member() {
+  static const std::string member = [] {
+    std::string lines;
+    for (std::size_t i = 0; i < (std::size_t{16} << 20) / 12; ++i) lines += "0.5 0.5 0.5\n";
+    return gzip_member(lines);
+  }();
+  return member;
+}
+
+// Peak RSS of `vertexflow info` on each bomb, measured when this test was written: 63 MB
+// (zeros), 192 MB (vertex lines), 61 MB (trailing), of which about 60 MB is the CLI itself
+// (its libraries). The bar is the issue's 300 MB; the old reader reached 10-11 GB.
+constexpr long kMaxRssKb = 300 * 1024;
+// A hang guard, not a speed check (the runs took 0.2-1.7 s).
+constexpr double kWatchdogSeconds = 120;
+
+void expect_one_line_error(const test::WatchedRun& run, const fs::path& file, const std::string& fragment) {
+  EXPECT_FALSE(run.timed_out) << "watchdog: still running after " << kWatchdogSeconds << " s";
+  EXPECT_EQ(run.exit_code, 1) << run.err;
+  EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+  EXPECT_NE(run.err.find(file.string() + ": "), std::string::npos) << run.err;
+  EXPECT_NE(run.err.find(fragment), std::string::npos) << run.err;
+  EXPECT_LT(run.peak_rss_kb, kMaxRssKb) << run.err;
+}
+
+TEST(GzipBomb, FiveGigabytesOfZerosFailAtTheHeader) {
+  const ScratchDir scratch("bomb-zeros");
+  const fs::path bomb = scratch.file("zeros.ply.gz");
+  write_file(bomb, "", gzip_member(std::string(std::size_t{64} << 20, '\0')), 80);  // 5 GiB, 5.2 MB
+  const auto run = test::run_cli_watched({"info", bomb.string()}, kWatchdogSeconds);
+  expect_one_line_error(run, bomb, "not a PLY file");
+}
+
+TEST(GzipBomb, AValidHeaderAndAGigabyteOfVertexLinesStopAtTheLimit) {
+  const ScratchDir scratch("bomb-lines");
+  const fs::path bomb = scratch.file("lines.ply.gz");
+  // The header's 10 million vertices fit the limit's bytes; the lines run past it.
+  write_file(bomb, gzip_member(ply_header(10'000'000)), vertex_lines_member(), 64);  // 1 GiB, 2.1 MB
+  const auto run = test::run_cli_watched({"info", bomb.string()}, kWatchdogSeconds);
+  expect_one_line_error(run, bomb, "gzip data inflates to more than 67108864 bytes");
+  EXPECT_NE(run.err.find("VERTEXFLOW_MAX_INFLATE_RATIO"), std::string::npos) << run.err;
+
+  // The environment variable moves the limit: 40 x 2.1 MB is above the 64 MiB floor.
+  const auto raised =
+      test::run_cli_watched({"info", bomb.string()}, kWatchdogSeconds, {"VERTEXFLOW_MAX_INFLATE_RATIO=40"});
+  const auto compressed = fs::file_size(bomb);
+  expect_one_line_error(raised, bomb,
+                        "inflates to more than " + std::to_string(40 * compressed) + " bytes, the limit for " +
+                            std::to_string(compressed) + " compressed bytes (40 times as many");
+}
+
+TEST(GzipBomb, AHeaderClaimingMoreThanTheLimitCanHoldFailsAtTheHeader) {
+  const ScratchDir scratch("bomb-claim");
+  const fs::path bomb = scratch.file("claim.ply.gz");
+  write_file(bomb, gzip_member(ply_header(1'000'000'000)), vertex_lines_member(), 64);
+  const auto run = test::run_cli_watched({"info", bomb.string()}, kWatchdogSeconds);
+  expect_one_line_error(run, bomb, "(the gzip inflation limit) can hold at most");
+}
+
+TEST(GzipBomb, AGigabyteAfterAValidMeshIsStillABomb) {
+  const ScratchDir scratch("bomb-trailing");
+  const fs::path bomb = scratch.file("trailing.ply.gz");
+  // A complete one-triangle mesh; the parser needs only its first member, but the stream is
+  // checked to its end (ByteSource::verify_rest), within the limit and in constant memory.
+  write_file(bomb, gzip_member(ply_header(3) + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n"), vertex_lines_member(), 64);
+  const auto run = test::run_cli_watched({"info", bomb.string()}, kWatchdogSeconds);
+  expect_one_line_error(run, bomb, "gzip data inflates to more than");
+}
+
+// --- streaming -------------------------------------------------------------------------------
+
+// An OBJ text of `n` vertex lines of varied length and faces over them.
+std::string obj_text(int n) {
+  std::string text;
+  for (int i = 0; i < n; ++i)
+    text += "v " + std::to_string(i % 1000) + " " + std::to_string(i / 1000) + ".125 " + std::to_string(i % 7) + "\n";
+  for (int i = 0; i + 1001 < n; i += 3) {
+    text += "f " + std::to_string(i + 1) + " " + std::to_string(i + 2) + " " + std::to_string(i + 1001) + "\n";
+  }
+  return text;
+}
+
+TEST(GzipStream, TheWindowStaysSmallWhileTheParserStreams) {
+  const std::string text = obj_text(1'000'000);  // about 24 MB
+  const std::string compressed = gzip_member(text, 1);
+  const std::string name = "big.obj.gz";
+  io_detail::ByteSource source(compressed, name, {});
+  io_detail::TextScanner in(source, name);
+  std::size_t largest_window = 0, tokens = 0;
+  while (!in.token().empty()) {
+    ++tokens;
+    largest_window = std::max(largest_window, source.data().size());
+  }
+  EXPECT_EQ(in.position(), text.size());
+  EXPECT_GT(tokens, 4'000'000u);
+  // Without dropping consumed bytes the window would be the whole 24 MB; with it, the first
+  // chunk (256 kB) is reused.
+  EXPECT_LE(largest_window, std::size_t{1} << 20) << "of " << text.size() << " bytes";
+}
+
+TEST(GzipStream, ReadsTheSameMeshAsThePlainFileForEveryFormat) {
+  for (const char* name : {"armadillo-43k.obj", "amo.off", "horse-48k.ply", "icosahedron_ascii.stl",
+                           "icosahedron_binary.stl", "fandisk_quads.off"}) {
+    SCOPED_TRACE(name);
+    const fs::path path = test::data_path(name);
+    const std::string bytes = test::read_text(path);
+    const MeshFormat format = format_from_path(path);
+    const Mesh plain = read_mesh_from_memory(bytes, format, name);
+    const Mesh inflated = read_mesh_from_memory(gzip_member(bytes, 6), format, name);
+    EXPECT_EQ(plain.V, inflated.V);
+    EXPECT_EQ(plain.F, inflated.F);
+  }
+}
+
+TEST(GzipStream, LineNumbersCountTheDroppedBytes) {
+  // Far past the first chunks, so the line number includes newlines that were dropped.
+  std::string text = obj_text(400'000);
+  const auto lines = std::count(text.begin(), text.end(), '\n');
+  text += "v 1 2 x\n";
+  const std::string expected = "line " + std::to_string(lines + 1) + ": expected a vertex coordinate, found 'x'";
+  for (const bool gzip : {false, true}) {
+    SCOPED_TRACE(gzip ? "gzip" : "plain");
+    try {
+      read_mesh_from_memory(gzip ? gzip_member(text, 1) : text, MeshFormat::Obj, "bad.obj");
+      ADD_FAILURE() << "accepted";
+    } catch (const IoError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(GzipStream, ATruncatedStreamIsAnErrorEvenAfterACompleteMesh) {
+  const std::string mesh = ply_header(3) + "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  const std::string padded = mesh + std::string(1 << 20, '\n');  // trailing bytes the parser never needs
+  std::string compressed = gzip_member(padded);
+  compressed.resize(compressed.size() - 6);  // cut into the CRC/size trailer
+  try {
+    read_mesh_from_memory(compressed, MeshFormat::Ply, "cut.ply.gz");
+    ADD_FAILURE() << "accepted";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("cut.ply.gz: truncated gzip data"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(read_mesh_from_memory(gzip_member(padded), MeshFormat::Ply, "whole.ply.gz").num_faces(), 1);
+}
+
+// --- the format from the content -------------------------------------------------------------
+
+TEST(FormatFromContent, APlyFileNamedObjIsReadAsPly) {
+  const std::string ply = test::read_text(test::data_path("horse-48k.ply"));
+  ReadReport report;
+  const Mesh mesh = read_mesh_from_memory(ply, MeshFormat::Obj, "horse.obj", &report);
+  EXPECT_EQ(report.format, MeshFormat::Ply);
+  EXPECT_TRUE(report.format_differs_from_extension);
+  EXPECT_EQ(mesh.F, read_mesh(test::data_path("horse-48k.ply")).F);
+  ASSERT_FALSE(report.warnings().empty());
+  EXPECT_NE(report.warnings().front().find("content is PLY"), std::string::npos) << report.warnings().front();
+}
+
+TEST(FormatFromContent, ABinaryStlWithASolidCommentAndATrailingByteIsBinary) {
+  std::string stl = test::read_text(test::data_path("icosahedron_binary.stl"));
+  stl.replace(0, 5, "solid");
+  stl += '\n';
+  ReadReport report;
+  const Mesh mesh = read_mesh_from_memory(stl, MeshFormat::Stl, "ico.stl", &report);
+  EXPECT_TRUE(report.binary);
+  EXPECT_EQ(mesh.num_faces(), 20);
+  EXPECT_EQ(mesh.num_vertices(), 12);
+}
+
+TEST(FormatFromContent, AnOffFileNamedPlyIsReadAsOff) {
+  const std::string off = test::read_text(test::data_path("fandisk.off"));
+  ReadReport report;
+  const Mesh mesh = read_mesh_from_memory(off, MeshFormat::Ply, "fandisk.ply", &report);
+  EXPECT_EQ(report.format, MeshFormat::Off);
+  EXPECT_EQ(mesh.F, read_mesh(test::data_path("fandisk.off")).F);
+}
+
+TEST(FormatFromContent, BinaryDataNamedObjFailsAtOnce) {
+  try {
+    read_mesh_from_memory(std::string(1 << 20, '\0'), MeshFormat::Obj, "zeros.obj");
+    ADD_FAILURE() << "accepted";
+  } catch (const IoError& e) {
+    EXPECT_STREQ(e.what(), "zeros.obj: not an OBJ file (it holds binary data, and OBJ is text)");
+  }
+}
+
+}  // namespace
+}  // namespace vertexflow
