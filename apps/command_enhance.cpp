@@ -10,9 +10,17 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <cerrno>
 #include <chrono>
-#include <fstream>
+#include <cstdint>
+#include <cstring>
 #include <sstream>
+#include <utility>
+
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 namespace vertexflow::cli {
 namespace {
@@ -31,11 +39,80 @@ struct EnhanceOptions {
   bool force = false;
 };
 
+// Closes a file descriptor on every way out of a scope.
+struct FdGuard {
+  int fd;
+  explicit FdGuard(int descriptor) : fd(descriptor) {}
+  FdGuard(const FdGuard&) = delete;
+  FdGuard& operator=(const FdGuard&) = delete;
+  ~FdGuard() {
+    if (fd >= 0) ::close(fd);
+  }
+};
+
+// Opens a pin file that is a regular file, and returns its descriptor and size. Anything else
+// is refused: a FIFO would block the command forever (O_NONBLOCK lets its open return, so it can
+// be refused), a device such as /dev/zero never ends, and a directory would read as an empty
+// list.
+std::pair<int, std::uint64_t> open_pin_file(const std::string& path) {
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  if (fd < 0) {
+    const int error = errno;
+    struct stat st {};
+    if (error == ENXIO && ::stat(path.c_str(), &st) == 0 && S_ISSOCK(st.st_mode))
+      throw IoError(path + ": is a socket, not a pin file");
+    throw IoError(path + ": cannot open the pin file: " + std::strerror(error));
+  }
+  FdGuard guard{fd};
+  struct stat st {};
+  if (::fstat(fd, &st) != 0) throw IoError(path + ": cannot stat the pin file: " + std::strerror(errno));
+  if (S_ISDIR(st.st_mode)) throw IoError(path + ": is a directory, not a pin file");
+  if (S_ISFIFO(st.st_mode)) throw IoError(path + ": is a FIFO, not a pin file");
+  if (S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode)) throw IoError(path + ": is a device, not a pin file");
+  if (!S_ISREG(st.st_mode)) throw IoError(path + ": is not a regular file, not a pin file");
+  guard.fd = -1;
+  return {fd, static_cast<std::uint64_t>(st.st_size)};
+}
+
+// Checks the pin file before the mesh is read, so a bad one fails at once.
+void check_pin_file(const std::string& path) {
+  const FdGuard guard{open_pin_file(path).first};
+}
+
 // Vertex indices (0-based), separated by white space; '#' starts a comment.
 std::vector<Index> read_pins(const std::string& path, Index num_vertices) {
-  std::ifstream in(path);
-  if (!in) throw IoError(path + ": cannot open the pin file");
+  // An index below 2^31 has at most 10 digits: listing every vertex once, with a separator,
+  // takes at most 11 bytes per vertex. 16 per vertex and 1 MiB for comments and layout is room
+  // for any sensible list, and still bounds what a wrong file (a log, a mesh) costs to read.
+  const std::uint64_t limit = (std::uint64_t{1} << 20) + 16 * static_cast<std::uint64_t>(num_vertices);
+  const auto [fd, size] = open_pin_file(path);
+  FdGuard guard{fd};
+  const auto too_large = [&] {
+    return IoError(
+        fmt::format("{}: is larger than a pin list for {} vertices can be ({} bytes)", path, num_vertices, limit));
+  };
+  if (size > limit) throw too_large();
+  // Read to the end rather than trusting the size: the file may grow (one byte past the limit
+  // is enough to refuse it).
+  std::string text(static_cast<std::size_t>(size) + 1, '\0');
+  std::size_t done = 0;
+  for (;;) {
+    if (done == text.size()) {
+      if (done > limit) throw too_large();
+      text.resize(std::min<std::uint64_t>(2 * text.size(), limit + 1));
+    }
+    const ssize_t n = ::read(fd, text.data() + done, text.size() - done);
+    if (n < 0) {
+      if (errno == EINTR) continue;
+      throw IoError(path + ": cannot read the pin file: " + std::strerror(errno));
+    }
+    if (n == 0) break;
+    done += static_cast<std::size_t>(n);
+  }
+  text.resize(done);
+
   std::vector<Index> pins;
+  std::istringstream in(text);
   std::string line;
   for (int number = 1; std::getline(in, line); ++number) {
     line = line.substr(0, line.find('#'));
@@ -143,6 +220,7 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
         throw IoError(o->report_file + ": the report would overwrite the output mesh");
     }
     if (!o->html_file.empty()) check_report_output(o->html_file, {o->input}, {o->output, o->report_file});
+    if (!o->pin_file.empty()) check_pin_file(o->pin_file);
     auto phase = [&](const std::string& what) {
       if (!global.quiet) fmt::print(stderr, "vertexflow: {}\n", what);
     };

@@ -8,6 +8,8 @@
 
 #include <fstream>
 
+#include <sys/stat.h>
+
 namespace vertexflow {
 namespace {
 
@@ -181,6 +183,58 @@ TEST(CliEnhance, BadPinFileAndNonManifoldInputFailCleanly) {
 
 namespace vertexflow {
 namespace {
+
+TEST(CliEnhance, PinFileMustBeARegularFileOfBoundedSize) {
+  test::ScratchDir dir("cli-enhance-pins");
+  const auto out = dir.file("out.ply");
+  const auto fifo = dir.file("pins.fifo");
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  // spot.obj has 2930 vertices: its pin list may be 1 MiB + 16 bytes per vertex. Two MB of
+  // valid indices is still too much.
+  const auto large = dir.file("large.txt");
+  {
+    std::ofstream file(large);
+    for (int i = 0; i < 1'000'000; ++i) file << "0\n";
+  }
+  const struct {
+    std::filesystem::path pins;
+    std::string problem;
+  } cases[] = {{fifo, "is a FIFO, not a pin file"},
+               {"/dev/zero", "is a device, not a pin file"},
+               {dir.path(), "is a directory, not a pin file"},
+               {large, "is larger than a pin list for 2930 vertices can be"},
+               {dir.file("missing.txt"), "cannot open the pin file: No such file or directory"}};
+  for (const auto& c : cases) {
+    // `timeout`: a pin file that blocks (a FIFO without a writer) fails the test instead of
+    // hanging it.
+    const auto r =
+        test::run_command("timeout 60 " + shell_quote(VERTEXFLOW_CLI) + " enhance " + quoted_data_path("spot.obj") +
+                          " " + shell_quote(out.string()) + " --pin " + shell_quote(c.pins.string()));
+    EXPECT_EQ(r.exit_code, 1) << c.pins;
+    if (c.pins == large) {  // the bound depends on the mesh, so this is found after reading it
+      const std::string line = "vertexflow: error: " + c.pins.string() + ": " + c.problem + " (" +
+                               std::to_string((1 << 20) + 16 * 2930) + " bytes)\n";
+      EXPECT_TRUE(r.err.size() >= line.size() && r.err.compare(r.err.size() - line.size(), line.size(), line) == 0)
+          << r.err;
+    } else {  // found before the mesh is read: no progress line before the error
+      EXPECT_EQ(r.err, "vertexflow: error: " + c.pins.string() + ": " + c.problem + "\n");
+    }
+    EXPECT_FALSE(std::filesystem::exists(out));
+  }
+  // A file just under the bound is read.
+  {
+    std::ofstream file(large);
+    file << "# the first vertex, many times\n";
+    for (int i = 0; i < ((1 << 20) + 16 * 2930 - 40) / 2; ++i) file << "0\n";
+  }
+  ASSERT_LE(std::filesystem::file_size(large), static_cast<std::uintmax_t>((1 << 20) + 16 * 2930));
+  const auto ok =
+      run_cli("--quiet enhance " + quoted_data_path("spot.obj") + " " + shell_quote(out.string()) + " --pin " +
+              shell_quote(large.string()) + " --report " + shell_quote(dir.file("r.json").string()));
+  EXPECT_EQ(ok.exit_code, 0) << ok.err;
+  EXPECT_EQ(nlohmann::json::parse(test::read_text(dir.file("r.json")))["options"]["pinned"],
+            ((1 << 20) + 16 * 2930 - 40) / 2);
+}
 
 TEST(CliEnhance, SameBytesWhateverTheBlasThreadCount) {
   test::ScratchDir dir("cli-enhance-deterministic");
