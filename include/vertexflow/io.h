@@ -114,6 +114,13 @@ struct WriteOptions {
 /// Writes a mesh, format chosen by extension (".gz" compresses). The file is written to a
 /// temporary file in the same directory and renamed into place, so `path` is either left as it
 /// was or holds the complete new mesh. Throws IoError.
+///
+/// On Linux the temporary file is unnamed (O_TMPFILE) until the moment it is renamed into
+/// place, so a process killed mid-write (even by SIGKILL) leaves nothing behind. Where the file
+/// system lacks O_TMPFILE (or the environment variable VERTEXFLOW_NO_O_TMPFILE is set, for
+/// tests) it is a hidden named file `.NAME.tmp-NNN`, which a handler installed on first use
+/// removes on SIGINT and SIGTERM before the process dies of the signal; the handler is installed
+/// only over the default disposition, never over a program's own handler or SIG_IGN.
 void write_mesh(const std::filesystem::path& path, const Mesh& mesh, const WriteOptions& options = {});
 
 /// Writes `text` to `path` atomically (temporary file beside it, then rename). Throws IoError.

@@ -1,5 +1,6 @@
 // Writers for OBJ, PLY, OFF and STL, optionally gzip-compressed, with atomic replacement:
-// bytes go to a temporary file beside the target, which is renamed over it only when complete.
+// bytes go to a temporary file beside the target (unnamed where the file system allows, so a
+// killed process leaves nothing behind), which is renamed over it only when complete.
 #include "io_internal.h"
 
 #include <zlib.h>
@@ -7,8 +8,12 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
+#include <atomic>
 #include <cerrno>
+#include <csignal>
 #include <cstdlib>
+#include <mutex>
 #include <random>
 #include <fcntl.h>
 #include <sys/stat.h>
@@ -18,35 +23,153 @@ namespace vertexflow {
 namespace io_detail {
 namespace {
 
+// Named temporary files that exist right now, so that SIGINT and SIGTERM can remove them
+// before the process dies (SIGKILL cannot be caught: that is why unnamed files come first).
+// The handler may run at any moment on any thread, so the registry is fixed storage and
+// lock-free atomics only. A slot is Free, Filling (its path being copied in, the file not yet
+// created), Armed (the file exists: the handler removes it) or Taken by the handler.
+struct TemporarySlot {
+  std::atomic<int> state{0};
+  char path[4096];  // PATH_MAX: open() refuses longer paths anyway
+};
+// Concurrent writes; a write beyond that many is simply not protected.
+std::array<TemporarySlot, 16> temporary_slots;
+
+class TemporaryRegistry {
+ public:
+  static constexpr int kNone = -1;
+
+  // Reserves a slot for the file `name` before it is created; kNone if every slot is busy or
+  // the path is too long, and then the file is simply not protected.
+  static int reserve(const std::string& name) {
+    install_handlers();
+    // Absolute, in case the working directory changes before a signal comes.
+    std::error_code ec;
+    const std::string path = std::filesystem::absolute(name, ec).string();
+    if (ec || path.size() >= sizeof(TemporarySlot::path)) return kNone;
+    for (std::size_t i = 0; i < temporary_slots.size(); ++i) {
+      int expected = kFree;
+      if (temporary_slots[i].state.compare_exchange_strong(expected, kFilling)) {
+        std::memcpy(temporary_slots[i].path, path.c_str(), path.size() + 1);
+        return static_cast<int>(i);
+      }
+    }
+    return kNone;
+  }
+  // The file now exists. Only from here may the handler unlink the path: before, it could name
+  // someone else's file (the O_EXCL or linkat that reports EEXIST).
+  static void arm(int slot) {
+    if (slot != kNone) temporary_slots[static_cast<std::size_t>(slot)].state.store(kArmed);
+  }
+  static void release(int slot) {
+    if (slot == kNone) return;
+    std::atomic<int>& state = temporary_slots[static_cast<std::size_t>(slot)].state;
+    int current = state.load();
+    // A slot the handler has taken stays taken: the process is about to die.
+    while (current != kTaken && !state.compare_exchange_weak(current, kFree)) {
+    }
+  }
+
+ private:
+  enum State { kFree, kFilling, kArmed, kTaken };
+  static_assert(std::atomic<int>::is_always_lock_free, "the signal handler needs lock-free atomics");
+
+  static void handle(int signal) {
+    for (TemporarySlot& slot : temporary_slots) {
+      int expected = kArmed;
+      if (slot.state.compare_exchange_strong(expected, kTaken)) ::unlink(slot.path);
+    }
+    // Die of the same signal, so the exit status tells the parent what happened. The signal is
+    // blocked while its handler runs; it is delivered, with the default action, on return.
+    struct sigaction dfl {};
+    dfl.sa_handler = SIG_DFL;
+    ::sigaction(signal, &dfl, nullptr);
+    ::raise(signal);
+  }
+
+  // Once, and only over the default disposition: a program that ignores these signals or
+  // handles them itself keeps its choice, and its own clean-up.
+  static void install_handlers() {
+    static std::once_flag once;
+    std::call_once(once, [] {
+      for (const int signal : {SIGINT, SIGTERM}) {
+        struct sigaction old {};
+        if (::sigaction(signal, nullptr, &old) != 0 || (old.sa_flags & SA_SIGINFO) || old.sa_handler != SIG_DFL)
+          continue;
+        struct sigaction action {};
+        action.sa_handler = handle;
+        sigemptyset(&action.sa_mask);
+        action.sa_flags = SA_RESTART;
+        ::sigaction(signal, &action, nullptr);
+      }
+    });
+  }
+};
+
+std::string random_hidden_name(const std::filesystem::path& target) {
+  static thread_local std::mt19937 random{std::random_device{}()};
+  const std::filesystem::path dir = target.has_parent_path() ? target.parent_path() : ".";
+  // Hidden, beside the target, so the rename stays on one file system.
+  std::string hidden = ".";
+  hidden += target.filename().string();
+  hidden += ".tmp-";
+  hidden += std::to_string(random());
+  return (dir / hidden).string();
+}
+
+// Whether open(O_TMPFILE) failed because the file system or kernel lacks it (the caller falls
+// back to a named file), rather than for a reason a named file would share (EACCES, ENOENT...).
+bool tmpfile_unsupported(int error) {
+  // EISDIR: kernels before 3.11 see only the O_DIRECTORY bit of O_TMPFILE.
+  return error == EOPNOTSUPP || error == EISDIR || error == EINVAL;
+}
+
 // A temporary file in the target's directory; commit() renames it into place, the destructor
-// removes it if commit() was not reached (an exception, a full disk).
+// discards it if commit() was not reached (an exception, a full disk).
+//
+// On Linux the file is unnamed (O_TMPFILE): until commit() it has no name, so however the
+// process dies (SIGKILL, a crash, power loss) nothing is left behind. commit() gives it a
+// short-lived name with linkat() and renames that over the target (linkat cannot replace a
+// file). Where O_TMPFILE is unavailable, the file is named from the start, as on other
+// systems, and registered for removal on SIGINT and SIGTERM.
 class AtomicFile {
  public:
   explicit AtomicFile(std::filesystem::path target) : target_(std::move(target)) {
-    const std::filesystem::path dir = target_.has_parent_path() ? target_.parent_path() : ".";
-    // Hidden name beside the target, so the rename stays on one file system. Created with mode
-    // 0666 so the process's umask gives the file its usual permissions (mkstemp would give
-    // 0600); O_EXCL with a random suffix makes the name ours.
-    std::random_device random;
+#ifdef O_TMPFILE
+    // VERTEXFLOW_NO_O_TMPFILE: tests take the fallback on file systems that have O_TMPFILE.
+    // Without /proc there is no way to give the file a name (AT_EMPTY_PATH needs a capability).
+    if (std::getenv("VERTEXFLOW_NO_O_TMPFILE") == nullptr && ::access("/proc/self/fd", X_OK) == 0) {
+      const std::filesystem::path dir = target_.has_parent_path() ? target_.parent_path() : ".";
+      // Mode 0666, like the named file below: the umask gives the usual permissions.
+      fd_ = ::open(dir.c_str(), O_TMPFILE | O_WRONLY | O_CLOEXEC, 0666);
+      if (fd_ >= 0) return;
+      if (!tmpfile_unsupported(errno)) cannot_create(errno);
+    }
+#endif
+    // O_EXCL with a random suffix makes the name ours; mode 0666 and the umask give the file
+    // its usual permissions (mkstemp would give 0600).
     for (int attempt = 0; attempt < 100 && fd_ < 0; ++attempt) {
-      std::string hidden = ".";
-      hidden += target_.filename().string();
-      hidden += ".tmp-";
-      hidden += std::to_string(random());
-      temp_ = (dir / hidden).string();
+      temp_ = random_hidden_name(target_);
+      slot_ = TemporaryRegistry::reserve(temp_);
       fd_ = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-      if (fd_ < 0 && errno != EEXIST) break;
+      const int error = errno;
+      if (fd_ >= 0) {
+        TemporaryRegistry::arm(slot_);
+        break;
+      }
+      TemporaryRegistry::release(slot_);
+      slot_ = TemporaryRegistry::kNone;
+      temp_.clear();
+      if (error != EEXIST) cannot_create(error);
     }
-    if (fd_ < 0) {
-      committed_ = true;  // nothing to remove
-      fail(target_.string(), std::string("cannot create a temporary file beside it: ") + std::strerror(errno));
-    }
+    if (fd_ < 0) cannot_create(EEXIST);
   }
   AtomicFile(const AtomicFile&) = delete;
   AtomicFile& operator=(const AtomicFile&) = delete;
   ~AtomicFile() {
     if (fd_ >= 0) ::close(fd_);
-    if (!committed_) ::unlink(temp_.c_str());
+    if (!temp_.empty()) ::unlink(temp_.c_str());
+    TemporaryRegistry::release(slot_);
   }
 
   void write(const char* data, std::size_t size) {
@@ -64,21 +187,48 @@ class AtomicFile {
   void commit() {
     // Data on disk before the rename.
     if (::fsync(fd_) != 0) fail(target_.string(), std::string("cannot flush: ") + std::strerror(errno));
-    if (::close(fd_) != 0) {
-      fd_ = -1;
-      fail(target_.string(), std::string("cannot close: ") + std::strerror(errno));
-    }
+    if (temp_.empty()) link_unnamed();
+    const int fd = fd_;
     fd_ = -1;
+    if (::close(fd) != 0) fail(target_.string(), std::string("cannot close: ") + std::strerror(errno));
     if (::rename(temp_.c_str(), target_.c_str()) != 0)
       fail(target_.string(), std::string("cannot rename the temporary file into place: ") + std::strerror(errno));
-    committed_ = true;
+    temp_.clear();  // it is the target now
+    TemporaryRegistry::release(slot_);
+    slot_ = TemporaryRegistry::kNone;
   }
 
  private:
+  [[noreturn]] void cannot_create(int error) {
+    fail(target_.string(), std::string("cannot create a file in its directory: ") + std::strerror(error));
+  }
+
+  // Names the unnamed file. From here to the rename in commit() is the only moment a name
+  // exists; it is registered, so SIGINT and SIGTERM remove it (SIGKILL in these few
+  // microseconds would leave it).
+  void link_unnamed() {
+    const std::string proc = "/proc/self/fd/" + std::to_string(fd_);
+    for (int attempt = 0; attempt < 100; ++attempt) {
+      std::string name = random_hidden_name(target_);
+      slot_ = TemporaryRegistry::reserve(name);
+      if (::linkat(AT_FDCWD, proc.c_str(), AT_FDCWD, name.c_str(), AT_SYMLINK_FOLLOW) == 0) {
+        TemporaryRegistry::arm(slot_);
+        temp_ = std::move(name);
+        return;
+      }
+      const int error = errno;
+      TemporaryRegistry::release(slot_);
+      slot_ = TemporaryRegistry::kNone;
+      if (error != EEXIST)
+        fail(target_.string(), std::string("cannot link the temporary file into place: ") + std::strerror(error));
+    }
+    fail(target_.string(), "cannot link the temporary file into place: no free name");
+  }
+
   std::filesystem::path target_;
-  std::string temp_;
+  std::string temp_;  // the file's name; empty while it has none (O_TMPFILE) or once committed
   int fd_ = -1;
-  bool committed_ = false;
+  int slot_ = TemporaryRegistry::kNone;
 };
 
 // Buffers output and passes it to the file, deflating it first for ".gz" targets.

@@ -5,7 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdlib>
 #include <fstream>
+
+#include <sys/stat.h>
 
 namespace vertexflow {
 namespace {
@@ -79,6 +82,51 @@ TEST(CheckOutputPath, RefusesTheInputUnlessForced) {
   EXPECT_THROW(check_output_path(input, dir.path(), false), IoError);
   EXPECT_THROW(check_output_path(input, dir.file("out.unknown"), false), IoError);
 }
+
+// Sets VERTEXFLOW_NO_O_TMPFILE for one scope: writes then use a named temporary file, as on
+// file systems without O_TMPFILE.
+class NamedTemporaryFiles {
+ public:
+  explicit NamedTemporaryFiles(bool on) {
+    if (on) ::setenv("VERTEXFLOW_NO_O_TMPFILE", "1", 1);
+  }
+  NamedTemporaryFiles(const NamedTemporaryFiles&) = delete;
+  NamedTemporaryFiles& operator=(const NamedTemporaryFiles&) = delete;
+  ~NamedTemporaryFiles() { ::unsetenv("VERTEXFLOW_NO_O_TMPFILE"); }
+};
+
+class WriteBothWays : public ::testing::TestWithParam<bool> {};
+
+TEST_P(WriteBothWays, NewFileGetsTheModeTheUmaskGives) {
+  const NamedTemporaryFiles named(GetParam());
+  test::ScratchDir dir("mode");
+  const mode_t old_mask = ::umask(022);
+  write_mesh(dir.file("a.obj"), triangle());
+  ::umask(077);
+  write_text_file(dir.file("b.txt"), "text\n");
+  ::umask(old_mask);
+  EXPECT_EQ(std::filesystem::status(dir.file("a.obj")).permissions(), static_cast<std::filesystem::perms>(0644));
+  EXPECT_EQ(std::filesystem::status(dir.file("b.txt")).permissions(), static_cast<std::filesystem::perms>(0600));
+  EXPECT_EQ(count_entries(dir.path()), 2);
+}
+
+TEST_P(WriteBothWays, FailureLeavesNoTemporaryFile) {
+  const NamedTemporaryFiles named(GetParam());
+  test::ScratchDir dir("atomic-both");
+  const auto path = dir.file("out.ply");
+  { std::ofstream(path) << "precious"; }
+  Mesh bad = triangle();
+  bad.vertex_properties.push_back({"broken", Eigen::VectorXd::Zero(2)});
+  EXPECT_THROW(write_mesh(path, bad), IoError);
+  EXPECT_EQ(test::read_text(path), "precious");
+  write_mesh(path, triangle());
+  EXPECT_EQ(read_mesh(path).num_faces(), 1);
+  EXPECT_EQ(count_entries(dir.path()), 1);
+}
+
+INSTANTIATE_TEST_SUITE_P(TemporaryFile, WriteBothWays, ::testing::Values(false, true), [](const auto& param_info) {
+  return param_info.param ? std::string("Named") : std::string("Unnamed");
+});
 
 TEST(WriteMesh, OptionsLeaveOutColoursAndProperties) {
   test::ScratchDir dir("options");
