@@ -3,8 +3,47 @@
 #include <fmt/format.h>
 
 #include <cstdio>
+#include <system_error>
 
 namespace vertexflow::cli {
+namespace {
+
+// Whether two paths name the same file, existing or not: weakly_canonical resolves the parts
+// that exist (symbolic links, "..") and normalises the rest, so "out.ply" and "./x/../out.ply"
+// match before either exists; equivalent() also catches hard links.
+bool same_file(const std::filesystem::path& a, const std::filesystem::path& b) {
+  std::error_code ec_a, ec_b, ec;
+  const std::filesystem::path ca = std::filesystem::weakly_canonical(a, ec_a);
+  const std::filesystem::path cb = std::filesystem::weakly_canonical(b, ec_b);
+  const bool same_name = ec_a || ec_b ? a.lexically_normal() == b.lexically_normal() : ca == cb;
+  return same_name || (std::filesystem::exists(a, ec) && std::filesystem::equivalent(a, b, ec));
+}
+
+}  // namespace
+
+void check_outputs(const std::vector<std::filesystem::path>& inputs, const std::vector<OutputFile>& outputs,
+                   bool force) {
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    const OutputFile& output = outputs[i];
+    if (output.path.empty()) continue;
+    std::error_code ec;
+    if (std::filesystem::is_directory(output.path, ec))
+      throw IoError(output.path.string() + ": is a directory, not an output file");
+    if (output.mesh) format_from_path(output.path);
+    for (const auto& input : inputs) {
+      if (!input.empty()) check_output_path(input, output.path, force && output.may_replace_input, output.mesh);
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (!outputs[j].path.empty() && same_file(output.path, outputs[j].path))
+        throw IoError(output.path.string() + ": would overwrite another output of the same command (" +
+                      outputs[j].path.string() + ")");
+    }
+  }
+  // Only once the paths are known to be distinct and safe: the probes touch the file system.
+  for (const OutputFile& output : outputs) {
+    if (!output.path.empty()) check_output_writable(output.path);
+  }
+}
 
 Mesh read_mesh_with_warnings(const std::filesystem::path& path, const GlobalOptions& global, ReadReport* report) {
   ReadReport local;

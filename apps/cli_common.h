@@ -10,6 +10,7 @@
 
 #include <filesystem>
 #include <string>
+#include <vector>
 
 namespace vertexflow::cli {
 
@@ -21,6 +22,24 @@ struct GlobalOptions {
 /// Reads a mesh and prints one warning line per cleanup count to stderr (unless quiet).
 Mesh read_mesh_with_warnings(const std::filesystem::path& path, const GlobalOptions& global,
                              ReadReport* report = nullptr);
+
+/// A file a subcommand writes.
+struct OutputFile {
+  std::filesystem::path path;  ///< empty: not requested, skipped
+  bool mesh = false;           ///< a mesh: needs a mesh extension
+  /// Whether --force lets it replace an input file. Only a mesh output may: a report never
+  /// replaces a mesh.
+  bool may_replace_input = false;
+};
+
+/// Checks every output of a subcommand before any work (before the inputs are read), so a bad
+/// path fails at once and no command writes some of its outputs and then fails on another's
+/// path. Each output must not be a directory, must have a mesh extension where a mesh is
+/// written, must be none of `inputs` (empty paths are skipped) unless `force` and
+/// may_replace_input, none of the other outputs, and its directory must accept a new file
+/// (check_output_writable). Throws IoError naming the path.
+void check_outputs(const std::vector<std::filesystem::path>& inputs, const std::vector<OutputFile>& outputs,
+                   bool force);
 
 /// Human-readable format name, e.g. "PLY (binary)".
 std::string describe_format(const ReadReport& report);

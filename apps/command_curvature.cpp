@@ -46,7 +46,7 @@ void register_curvature_command(CLI::App& app, const GlobalOptions& global) {
   command->add_flag("--json", o->json, "Print summary statistics as JSON on stdout");
   command->add_flag("--force", o->force, "Allow OUT to be the input file");
   command->callback([o, &global] {
-    check_output_path(o->input, o->output, o->force);
+    check_outputs({o->input}, {{o->output, /*mesh=*/true, /*may_replace_input=*/true}}, o->force);
     Mesh mesh = read_mesh_with_warnings(o->input, global);
     const Topology topology = build_topology(mesh.F, mesh.num_vertices());
     CurvatureOptions options;

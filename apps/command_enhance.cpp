@@ -210,16 +210,8 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
         throw std::runtime_error(std::string(name) + " applies to --method flow only");
     if (!unsharp && (weight->count() > 0 || smoothing->count() > 0))
       throw std::runtime_error("--weight and --smoothing-iterations apply to --method unsharp only");
-    check_output_path(o->input, o->output, o->force);
-    if (!o->report_file.empty()) {
-      check_output_path(o->input, o->report_file, o->force, /*mesh_output=*/false);
-      std::error_code ec;
-      if (std::filesystem::path(o->report_file).lexically_normal() ==
-              std::filesystem::path(o->output).lexically_normal() ||
-          (std::filesystem::exists(o->report_file, ec) && std::filesystem::equivalent(o->report_file, o->output, ec)))
-        throw IoError(o->report_file + ": the report would overwrite the output mesh");
-    }
-    if (!o->html_file.empty()) check_report_output(o->html_file, {o->input}, {o->output, o->report_file});
+    check_outputs({o->input},
+                  {{o->output, /*mesh=*/true, /*may_replace_input=*/true}, {o->report_file}, {o->html_file}}, o->force);
     if (!o->pin_file.empty()) check_pin_file(o->pin_file);
     auto phase = [&](const std::string& what) {
       if (!global.quiet) fmt::print(stderr, "vertexflow: {}\n", what);

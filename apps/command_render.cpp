@@ -87,9 +87,9 @@ void register_render_command(CLI::App& app, const GlobalOptions& global) {
   command->add_flag("--json", o->json, "Print the colour range, camera frame and timings as JSON on stdout");
   command->add_flag("--force", o->force, "Allow OUT to be one of the input files");
   command->callback([o, &global] {
-    for (const std::string& input : {o->input, o->before, o->frame_from})
-      if (!input.empty()) check_output_path(input, o->output, o->force, false);
     if (!has_png_extension(o->output)) throw IoError(o->output + ": the output must be a .png file");
+    check_outputs({o->input, o->before, o->frame_from}, {{o->output, /*mesh=*/false, /*may_replace_input=*/true}},
+                  o->force);
     RenderOptions options = o->render;
     std::smatch size;
     if (!std::regex_match(o->size, size, std::regex(R"((\d{1,5})[xX](\d{1,5}))")))

@@ -37,8 +37,7 @@ void register_report_command(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str();
   command->callback([o, &global] {
     // Reports never replace a mesh: there is no --force here.
-    check_report_output(o->html_file, {o->input, o->result}, {o->json_file});
-    if (!o->json_file.empty()) check_report_output(o->json_file, {o->input, o->result}, {o->html_file});
+    check_outputs({o->input, o->result}, {{o->html_file}, {o->json_file}}, /*force=*/false);
     const Mesh input = read_mesh_with_warnings(o->input, global);
     const Mesh result = read_mesh_with_warnings(o->result, global);
     if (result.num_vertices() != input.num_vertices() || result.F != input.F)

@@ -37,7 +37,7 @@ void register_simplify_command(CLI::App& app, const GlobalOptions& global) {
   command->add_flag("--json", o->json, "Print a summary as JSON on stdout");
   command->add_flag("--force", o->force, "Allow OUT to be the input file");
   command->callback([o, &global] {
-    check_output_path(o->input, o->output, o->force);
+    check_outputs({o->input}, {{o->output, /*mesh=*/true, /*may_replace_input=*/true}}, o->force);
     const Mesh mesh = read_mesh_with_warnings(o->input, global);
     o->simplify.keep_boundary = !o->free_boundary;
     SimplifyResult result;

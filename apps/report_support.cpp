@@ -9,7 +9,6 @@
 #include "vertexflow/topology.h"
 
 #include <cmath>
-#include <system_error>
 
 namespace vertexflow::cli {
 
@@ -52,18 +51,6 @@ nlohmann::json flow_metrics(const Vertices& input, const Vertices& result, const
   report["volume_change_percent"] =
       volume_before != 0 ? 100.0 * (signed_volume(result, F) - volume_before) / std::abs(volume_before) : 0.0;
   return report;
-}
-
-void check_report_output(const std::filesystem::path& output, const std::vector<std::filesystem::path>& inputs,
-                         const std::vector<std::filesystem::path>& other_outputs) {
-  for (const auto& input : inputs) check_output_path(input, output, /*force=*/false, /*mesh_output=*/false);
-  for (const auto& other : other_outputs) {
-    if (other.empty()) continue;
-    std::error_code ec;
-    if (output.lexically_normal() == other.lexically_normal() ||
-        (std::filesystem::exists(output, ec) && std::filesystem::equivalent(output, other, ec)))
-      throw IoError(output.string() + ": would overwrite another output of the same command (" + other.string() + ")");
-  }
 }
 
 HtmlReportOptions html_report_options(const std::filesystem::path& input, const std::filesystem::path& result) {

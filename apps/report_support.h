@@ -1,6 +1,6 @@
 // Pieces of the reports: the metrics of a flow result as JSON (what `vertexflow enhance
 // --report` writes beside its options and timings, and what `vertexflow report` and the HTML
-// report show), and checks and options for report files.
+// report show), and the options of the HTML report.
 #pragma once
 
 #include "vertexflow/html_report.h"
@@ -9,7 +9,6 @@
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
-#include <vector>
 
 namespace vertexflow::cli {
 
@@ -18,12 +17,6 @@ namespace vertexflow::cli {
 /// lengths, redistribution rho, edge-error CV and volume change. Throws std::invalid_argument
 /// for a non-manifold mesh (curvature.h).
 nlohmann::json flow_metrics(const Vertices& input, const Vertices& result, const Faces& F);
-
-/// Throws IoError unless the report file `output` may be written: not a directory, none of
-/// `inputs` (even with --force: a report never replaces a mesh), and none of the other outputs
-/// of the same command (empty paths are skipped).
-void check_report_output(const std::filesystem::path& output, const std::vector<std::filesystem::path>& inputs,
-                         const std::vector<std::filesystem::path>& other_outputs);
 
 /// HTML report options whose title and labels name the two mesh files.
 HtmlReportOptions html_report_options(const std::filesystem::path& input, const std::filesystem::path& result);

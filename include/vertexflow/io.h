@@ -126,6 +126,11 @@ void write_mesh(const std::filesystem::path& path, const Mesh& mesh, const Write
 /// Writes `text` to `path` atomically (temporary file beside it, then rename). Throws IoError.
 void write_text_file(const std::filesystem::path& path, std::string_view text);
 
+/// Throws IoError unless a file can be written at `output` now: it is not a directory and its
+/// directory accepts a new file (probed by creating and discarding the temporary file that
+/// write_mesh would start with). For checking every output of a command before any work.
+void check_output_writable(const std::filesystem::path& output);
+
 /// Throws IoError unless `output` is safe to write while `input` is being processed: it must
 /// not be the same file as the input (unless `force`), must not be a directory and, when
 /// `mesh_output`, must have a mesh extension.

@@ -489,6 +489,15 @@ void write_text_file(const std::filesystem::path& path, std::string_view text) {
   out.commit();
 }
 
+void check_output_writable(const std::filesystem::path& output) {
+  std::error_code ec;
+  if (std::filesystem::is_directory(output, ec)) io_detail::fail(output.string(), "is a directory, not an output file");
+  // The very file a write would start with, discarded at once: whatever would stop the write
+  // (a missing directory, permissions, a read-only file system, a parent that is not a
+  // directory) stops this, and nothing is left behind.
+  io_detail::AtomicFile probe(output);
+}
+
 void check_output_path(const std::filesystem::path& input, const std::filesystem::path& output, bool force,
                        bool mesh_output) {
   std::error_code ec;

@@ -257,7 +257,7 @@ TEST(CliEnhance, RefusesAReportOverTheOutput) {
   const auto r = run_cli("enhance " + quoted_data_path("spot.obj") + " " + shell_quote(out.string()) + " --report " +
                          shell_quote(out.string()));
   EXPECT_EQ(r.exit_code, 1);
-  EXPECT_NE(r.err.find("the report would overwrite the output mesh"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("would overwrite another output of the same command"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 

@@ -124,6 +124,26 @@ TEST_P(WriteBothWays, FailureLeavesNoTemporaryFile) {
   EXPECT_EQ(count_entries(dir.path()), 1);
 }
 
+TEST_P(WriteBothWays, CheckOutputWritableNamesThePathAndLeavesNothing) {
+  const NamedTemporaryFiles named(GetParam());
+  test::ScratchDir dir("writable");
+  EXPECT_NO_THROW(check_output_writable(dir.file("out.ply")));
+  EXPECT_NO_THROW(check_output_writable(dir.file("no-extension-needed")));
+  EXPECT_EQ(count_entries(dir.path()), 0);
+  { std::ofstream(dir.file("file")) << "x"; }
+  for (const auto& path : {dir.file("missing/out.ply"), dir.file("file/out.ply"), dir.path()}) {
+    try {
+      check_output_writable(path);
+      ADD_FAILURE() << "expected IoError for " << path;
+    } catch (const IoError& e) {
+      EXPECT_EQ(std::string(e.what()).rfind(path.string() + ": ", 0), 0u) << e.what();
+    }
+  }
+  // An existing file is replaced by the write, so it does not stop the check.
+  EXPECT_NO_THROW(check_output_writable(dir.file("file")));
+  EXPECT_EQ(count_entries(dir.path()), 1);
+}
+
 INSTANTIATE_TEST_SUITE_P(TemporaryFile, WriteBothWays, ::testing::Values(false, true), [](const auto& param_info) {
   return param_info.param ? std::string("Named") : std::string("Unnamed");
 });
