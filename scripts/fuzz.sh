@@ -3,6 +3,11 @@
 # fuzzer for SECONDS seconds (default 60), one after another.
 #
 #   scripts/fuzz.sh [SECONDS] [FORMAT...]      e.g. scripts/fuzz.sh 300 ply off
+#   scripts/fuzz.sh --replay                   build, then run every reader's fuzzer once over
+#                                              each kept input (seeds, tests/data/bad,
+#                                              tests/data/fuzz_regressions); ctest runs this
+#
+# FUZZ_BUILD_DIR overrides the build directory (default build-fuzz/ in the repository).
 #
 # Corpora persist in build-fuzz/corpus/FORMAT (seeded from tests/fuzz/seeds, tests/data/bad,
 # tests/data/fuzz_regressions and the small meshes in data/), so repeated runs build on each
@@ -11,13 +16,15 @@
 # tests/data/fuzz_regressions/ (input that must be read), where the unit tests pick it up.
 set -euo pipefail
 
+replay=0
+if [ "${1:-}" = "--replay" ]; then replay=1; shift; fi
 seconds=${1:-60}
 shift || true
 formats=("$@")
 if [ ${#formats[@]} -eq 0 ]; then formats=(obj ply off stl); fi
 
 root=$(cd "$(dirname "$0")/.." && pwd)
-build="$root/build-fuzz"
+build="${FUZZ_BUILD_DIR:-$root/build-fuzz}"
 CC=${CC:-clang}
 CXX=${CXX:-clang++}
 
@@ -40,6 +47,28 @@ seed() {
     done
   done
 }
+
+if [ "$replay" -eq 1 ]; then
+  # Every kept input of the format, plain or gzip, run once (file arguments: no fuzzing). A
+  # crash, a sanitizer report or a leak exits non-zero.
+  status=0
+  for f in "${formats[@]}"; do
+    inputs=()
+    for dir in "$root/tests/fuzz/seeds" "$root/tests/data/bad" "$root/tests/data/fuzz_regressions"; do
+      for file in "$dir"/*."$f" "$dir"/*."$f".gz; do
+        [ -f "$file" ] && inputs+=("$file")
+      done
+    done
+    echo "== fuzz_read_$f: replaying ${#inputs[@]} inputs"
+    if ! "$build/bin/fuzz_read_$f" -rss_limit_mb=2048 -malloc_limit_mb=512 -timeout=10 "${inputs[@]}" \
+      >"$build/replay_$f.log" 2>&1; then
+      grep -E '==[0-9]+==ERROR|SUMMARY|runtime error|Running: ' "$build/replay_$f.log" | tail -20 >&2
+      echo "!! fuzz_read_$f failed on a kept input; see $build/replay_$f.log" >&2
+      status=1
+    fi
+  done
+  exit $status
+fi
 
 status=0
 for f in "${formats[@]}"; do

@@ -47,6 +47,8 @@ const std::map<std::string, std::string> kExpected = {
     {"empty.stl", "the file is empty"},
     {"empty.ply.gz", "the file is empty"},
     // Random bytes.
+    {"obj_index_2_to_the_31.obj", "face 0 references vertex 2147483648, but the file has 3 vertices (valid: 1..3)"},
+    {"obj_all_vertices_at_one_point.obj", "the bounding box has zero size"},
     {"random.obj", "not an OBJ file (it holds binary data, and OBJ is text)"},
     {"random.ply", "not a PLY file"},
     {"random.off", "not an OFF file"},

@@ -234,6 +234,12 @@ def make_obj():
     write("obj_negative_index_beyond_start.obj", obj(OBJ_TRI + ["f -1 -2 -4"]))
     write("obj_index_too_large.obj", obj(OBJ_TRI + ["f 1 2 3000000000"]))
     write("obj_index_overflow.obj", obj(OBJ_TRI + ["f 1 2 99999999999999999999"]))
+    # Found by fuzz_read_obj (UBSan): 2^31 is a valid Index once 0-based; the message added the
+    # base back in 32 bits.
+    write("obj_index_2_to_the_31.obj", obj(OBJ_TRI + ["f 1 2 2147483648"]))
+    # Issue 12: every vertex at one point made `enhance` loop forever.
+    write("obj_all_vertices_at_one_point.obj",
+          obj(["v 1 1 1", "v 1 1 1", "v 1 1 1", "v 1 1 1", "f 1 3 2", "f 1 2 4", "f 1 4 3", "f 2 3 4"]))
     write("obj_face_garbage.obj", obj(OBJ_TRI + ["f 1 2 three"]))
     write("obj_garbage_number.obj", obj(["v 0 0 0", "v 1.0abc 0 0", "v 0 1 0", "f 1 2 3"]))
     write("obj_nan.obj", obj(["v 0 0 0", "v nan 0 0", "v 0 1 0", "f 1 2 3"]))
