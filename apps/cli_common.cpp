@@ -45,7 +45,17 @@ void check_outputs(const std::vector<std::filesystem::path>& inputs, const std::
   }
 }
 
+namespace {
+std::string& last_input() {
+  static std::string path;
+  return path;
+}
+}  // namespace
+
+const std::string& last_input_path() { return last_input(); }
+
 Mesh read_mesh_with_warnings(const std::filesystem::path& path, const GlobalOptions& global, ReadReport* report) {
+  last_input() = path.string();
   ReadReport local;
   ReadReport& r = report ? *report : local;
   Mesh mesh = read_mesh(path, &r);

@@ -41,6 +41,10 @@ struct OutputFile {
 void check_outputs(const std::vector<std::filesystem::path>& inputs, const std::vector<OutputFile>& outputs,
                    bool force);
 
+/// The mesh file read_mesh_with_warnings read last (empty before any): std::bad_alloc names no
+/// file, so main() takes this one for its one-line "out of memory" error.
+const std::string& last_input_path();
+
 /// Human-readable format name, e.g. "PLY (binary)".
 std::string describe_format(const ReadReport& report);
 

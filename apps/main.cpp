@@ -6,6 +6,19 @@
 
 #include <cstdio>
 #include <exception>
+#include <new>
+#include <string>
+#include <string_view>
+
+namespace {
+
+// "FILE: " for the mesh the command read last, or nothing before any read.
+std::string input_prefix() {
+  const std::string& input = vertexflow::cli::last_input_path();
+  return input.empty() ? std::string() : input + ": ";
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace vertexflow::cli;
@@ -27,8 +40,18 @@ int main(int argc, char** argv) {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e);
+  } catch (const vertexflow::IoError& e) {
+    fmt::print(stderr, "vertexflow: error: {}\n", e.what());  // names its file already
+    return 1;
+  } catch (const std::bad_alloc&) {
+    fmt::print(stderr, "vertexflow: error: {}out of memory\n", input_prefix());
+    return 1;
   } catch (const std::exception& e) {
-    fmt::print(stderr, "vertexflow: error: {}\n", e.what());
+    // The computation's errors (and the system's, such as a thread that cannot start) concern
+    // the mesh read last.
+    const std::string prefix = input_prefix();
+    const bool named = std::string_view(e.what()).substr(0, prefix.size()) == prefix;
+    fmt::print(stderr, "vertexflow: error: {}{}\n", named ? "" : prefix, e.what());
     return 1;
   }
   return 0;

@@ -8,7 +8,7 @@ packages=(
   libeigen3-dev            # dense/sparse linear algebra, V/F matrices
   libsuitesparse-dev       # CHOLMOD sparse Cholesky (flow solver)
   libmetis-dev             # fill-reducing ordering for CHOLMOD
-  libopenblas0-pthread     # BLAS for CHOLMOD supernodal
+  libopenblas0-serial      # BLAS for CHOLMOD supernodal, one thread (CMakeLists.txt says why)
   libtbb-dev               # parallel loops
   libcgal-dev              # polygon triangulation, AABB trees, remeshing, QEM
   libgmp-dev libmpfr-dev   # CGAL's exact kernels

@@ -45,6 +45,7 @@
 #include "vertexflow/timing.h"
 
 #include <cholmod.h>
+#include <sys/resource.h>
 #include <dlfcn.h>
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -60,6 +61,7 @@
 #include <numeric>
 #include <optional>
 #include <span>
+#include <new>
 #include <stdexcept>
 
 namespace vertexflow {
@@ -156,6 +158,19 @@ void use_single_threaded_blas() {
       return;
     }
   }
+}
+
+bool address_space_is_limited() {
+  for (const int resource : {RLIMIT_AS, RLIMIT_DATA}) {
+    rlimit limit{};
+    if (::getrlimit(resource, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY) return true;
+  }
+  return false;
+}
+
+// CHOLMOD reports running out of memory in its status; everything else is a numerical failure.
+void throw_if_out_of_memory(const cholmod_common& common) {
+  if (common.status == CHOLMOD_OUT_OF_MEMORY || common.status == CHOLMOD_TOO_LARGE) throw std::bad_alloc();
 }
 
 // The per-vertex factors of H and b (see the top of this file), in normalised units, over the
@@ -842,7 +857,11 @@ struct FlowSystemSolver::Impl {
   Impl(const Topology& t, std::vector<char> f, LinearSolver k, double tol)
       : topology(t), fixed(std::move(f)), kind(k), tolerance(tol) {
     cholmod_l_start(&common);
-    common.supernodal = CHOLMOD_SUPERNODAL;
+    // Supernodal factorisation calls BLAS, and OpenBLAS spins forever when it cannot map its
+    // work buffer (seen under `ulimit -v`, issue 12). Under an address-space limit the
+    // simplicial method, which needs no BLAS, reports running out of memory instead.
+    common.supernodal = address_space_is_limited() ? CHOLMOD_SIMPLICIAL : CHOLMOD_SUPERNODAL;
+    common.print = 0;  // failures become exceptions (one line from the CLI), never CHOLMOD's own prints
   }
   ~Impl() {
     if (factor) cholmod_l_free_factor(&factor, &common);
@@ -909,6 +928,7 @@ void FlowSystemSolver::Impl::order_vertices(const Terms& terms) {
   const Index m = num_free();
   cholmod_sparse* pattern = cholmod_l_allocate_sparse(static_cast<std::size_t>(m), static_cast<std::size_t>(m),
                                                       row_columns.size(), 1, 1, 1, CHOLMOD_PATTERN, &common);
+  if (!pattern) throw std::bad_alloc();
   auto* p = static_cast<SuiteSparse_long*>(pattern->p);
   auto* i = static_cast<SuiteSparse_long*>(pattern->i);
   std::copy(row_start.begin(), row_start.end(), p);
@@ -918,6 +938,7 @@ void FlowSystemSolver::Impl::order_vertices(const Terms& terms) {
   cholmod_factor* symbolic = cholmod_l_analyze(pattern, &common);
   if (!symbolic) {
     cholmod_l_free_sparse(&pattern, &common);
+    throw_if_out_of_memory(common);
     throw std::runtime_error("vertex flow: CHOLMOD could not order the vertex graph");
   }
   scalar_factor_entries = common.lnz;
@@ -944,7 +965,7 @@ cholmod_sparse* FlowSystemSolver::Impl::assemble(const Terms& t) {
   const auto entries = static_cast<std::size_t>(column_start.back());
   cholmod_sparse* A = cholmod_l_allocate_sparse(3 * static_cast<std::size_t>(m), 3 * static_cast<std::size_t>(m),
                                                 entries, 1, 1, 1, CHOLMOD_REAL, &common);
-  if (!A) throw std::runtime_error("vertex flow: out of memory for the normal matrix");
+  if (!A) throw std::bad_alloc();
   std::copy(column_start.begin(), column_start.end(), static_cast<SuiteSparse_long*>(A->p));
   auto* rows = static_cast<SuiteSparse_long*>(A->i);
   auto* values = static_cast<double*>(A->x);
@@ -1015,18 +1036,21 @@ Vector FlowSystemSolver::Impl::factor_and_solve(const Terms& terms, const Vector
   }
   const bool ok = factor && cholmod_l_factorize(A, factor, &common) && common.status == CHOLMOD_OK;
   cholmod_l_free_sparse(&A, &common);
+  throw_if_out_of_memory(common);
   if (!ok) throw std::runtime_error("vertex flow: the normal matrix is not positive definite");
   report.seconds_factorization += seconds_since(start);
 
   start = Clock::now();
   cholmod_dense* rhs = cholmod_l_allocate_dense(3 * static_cast<std::size_t>(m), 1, 3 * static_cast<std::size_t>(m),
                                                 CHOLMOD_REAL, &common);
+  if (!rhs) throw std::bad_alloc();
   auto* rhs_values = static_cast<double*>(rhs->x);
   for (Index a = 0; a < m; ++a)
     for (int c = 0; c < 3; ++c)
       rhs_values[3 * a + c] = b[3 * static_cast<Eigen::Index>(free_vertex[static_cast<std::size_t>(a)]) + c];
   cholmod_dense* x = cholmod_l_solve(CHOLMOD_A, factor, rhs, &common);
   cholmod_l_free_dense(&rhs, &common);
+  throw_if_out_of_memory(common);
   if (!x) throw std::runtime_error("vertex flow: the triangular solves failed");
   Vector d = Vector::Zero(b.size());
   const auto* x_values = static_cast<const double*>(x->x);
