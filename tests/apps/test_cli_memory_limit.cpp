@@ -12,14 +12,6 @@
 namespace vertexflow {
 namespace {
 
-#if defined(__SANITIZE_ADDRESS__)
-#define VERTEXFLOW_TEST_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define VERTEXFLOW_TEST_ASAN 1
-#endif
-#endif
-
 TEST(CliMemoryLimit, EveryRunEndsWithSuccessOrOneErrorLine) {
 #ifdef VERTEXFLOW_TEST_ASAN
   GTEST_SKIP() << "AddressSanitizer reserves terabytes of address space";

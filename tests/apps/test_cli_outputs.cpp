@@ -20,9 +20,7 @@ namespace {
 using test::run_cli;
 using test::shell_quote;
 
-std::string q(const std::filesystem::path& path) {
-  return shell_quote(path.string());
-}
+std::string q(const std::filesystem::path& path) { return test::quoted(path); }
 
 std::vector<std::string> entries(const std::filesystem::path& dir) {
   std::vector<std::string> names;

@@ -339,14 +339,6 @@ TEST(BadInput, HugeHeaderCountsDoNotAllocate) {
   EXPECT_LT(growth_mb, 200) << "peak RSS grew by " << growth_mb << " MB reading files of a few kB";
 }
 
-#if defined(__SANITIZE_ADDRESS__)
-#define VERTEXFLOW_TEST_ASAN 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define VERTEXFLOW_TEST_ASAN 1
-#endif
-#endif
-
 // Peak RSS misses an allocation that is reserved but never touched (vector::reserve of 16 GB
 // succeeds on Linux without using memory). A child process with its address space capped at
 // 1 GB above the current size catches that too: any such allocation throws std::bad_alloc.

@@ -14,9 +14,7 @@ namespace {
 using test::run_cli;
 using test::shell_quote;
 
-std::string q(const std::filesystem::path& path) {
-  return shell_quote(path.string());
-}
+std::string q(const std::filesystem::path& path) { return test::quoted(path); }
 
 TEST(CliReport, EnhanceWritesTheHtmlReportWithTheJsonMetrics) {
   test::ScratchDir dir("cli-report-enhance");

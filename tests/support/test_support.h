@@ -7,6 +7,15 @@
 #include <string>
 #include <vector>
 
+// Set in AddressSanitizer builds, whose reserved address space defeats address-space limits.
+#if defined(__SANITIZE_ADDRESS__)
+#define VERTEXFLOW_TEST_ASAN 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define VERTEXFLOW_TEST_ASAN 1
+#endif
+#endif
+
 namespace vertexflow::test {
 
 /// A mesh bundled in data/ (VERTEXFLOW_DATA_DIR is set by tests/CMakeLists.txt).
@@ -65,6 +74,9 @@ WatchedRun run_cli_watched(const std::vector<std::string>& arguments, double tim
 
 /// Single-quotes a string for /bin/sh.
 std::string shell_quote(const std::string& s);
+
+/// A path single-quoted for /bin/sh.
+inline std::string quoted(const std::filesystem::path& path) { return shell_quote(path.string()); }
 
 /// data_path(name), single-quoted for /bin/sh: a bundled mesh as a CLI argument.
 inline std::string quoted_data_path(const std::string& name) {
