@@ -6,6 +6,11 @@
 // replacement.
 //
 //   build/bin/bench_io --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+//
+// read/comb_polygon/N reads an OBJ, held in memory, whose only face is a comb-shaped simple
+// polygon of N corners (issue 12: its triangulation was quadratic, 31 s for 100k corners):
+//
+//   build/bin/bench_io --benchmark_filter=comb
 #include "bench_support.h"
 
 #include "vertexflow/io.h"
@@ -18,6 +23,7 @@
 #include <iostream>
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace vertexflow::bench {
@@ -121,6 +127,36 @@ void write_case(benchmark::State& state, const Format* format) {
   std::filesystem::remove(path);
 }
 
+// One OBJ face, a comb with N / 4 teeth of width 1 and length N / 4 leaning sideways by N / 16,
+// so that each long edge runs past O(N) corners (tests/io/test_triangulate.cpp uses the same).
+std::string comb_obj(int corners) {
+  const int teeth = corners / 4;
+  const double height = teeth, lean = corners / 16.0;
+  std::vector<std::pair<double, double>> points = {{0, 0}, {2.0 * teeth - 1, 0}};
+  for (int k = teeth - 1; k >= 0; --k) {
+    points.insert(points.end(), {{2.0 * k + 1 + lean, height}, {2.0 * k + lean, height}});
+    if (k > 0) points.insert(points.end(), {{2.0 * k, 1}, {2.0 * k - 1, 1}});
+  }
+  std::string obj;
+  for (const auto& [x, y] : points) obj += "v " + std::to_string(x) + ' ' + std::to_string(y) + " 0\n";
+  obj += 'f';
+  for (std::size_t i = 1; i <= points.size(); ++i) obj += ' ' + std::to_string(i);
+  obj += '\n';
+  return obj;
+}
+
+void read_comb_case(benchmark::State& state) {
+  const std::string obj = comb_obj(static_cast<int>(state.range(0)));
+  Index faces = 0;
+  for (auto _ : state) {
+    Mesh mesh = read_mesh_from_memory(obj, MeshFormat::Obj, "comb.obj");
+    faces = mesh.num_faces();
+    benchmark::DoNotOptimize(mesh.F.data());
+    benchmark::ClobberMemory();
+  }
+  state.counters["faces"] = faces;
+}
+
 void register_cases() {
   for (const Format& format : formats()) {
     benchmark::RegisterBenchmark((std::string("read/") + format.name).c_str(), read_case, &format)
@@ -132,6 +168,13 @@ void register_cases() {
         ->Unit(benchmark::kMillisecond)
         ->UseRealTime();
   }
+  benchmark::RegisterBenchmark("read/comb_polygon", read_comb_case)
+      ->Arg(12500)
+      ->Arg(25000)
+      ->Arg(50000)
+      ->Arg(100000)
+      ->Unit(benchmark::kMillisecond)
+      ->UseRealTime();
 }
 
 }  // namespace
