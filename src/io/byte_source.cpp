@@ -82,8 +82,8 @@ ByteSource::ByteSource(std::string_view bytes, const std::string& name, const In
 
 ByteSource::~ByteSource() = default;
 
-bool ByteSource::request(std::size_t end, std::size_t keep_from) {
-  if (end > this->end() && !complete_) inflate_until(end, keep_from);
+bool ByteSource::request_more(std::size_t end, std::size_t keep_from) {
+  if (!complete_) inflate_until(end, keep_from);
   return end <= this->end();
 }
 

@@ -46,7 +46,9 @@ class ByteSource {
   /// returns whether it does. Bytes before position `keep_from` (at most offset() + the bytes
   /// the caller still needs) may be dropped, which keeps memory to a window for a parser that
   /// streams through; positions stay those of the whole content.
-  bool request(std::size_t end, std::size_t keep_from);
+  bool request(std::size_t end, std::size_t keep_from) {
+    return end <= this->end() || request_more(end, keep_from);  // inline: called per value
+  }
 
   /// Makes every byte from offset() on available (for formats that need the total size, e.g.
   /// binary STL); drops nothing.
@@ -68,6 +70,7 @@ class ByteSource {
 
  private:
   struct Inflater;
+  bool request_more(std::size_t end, std::size_t keep_from);
   // Inflates until end() >= end or the stream ends, dropping bytes before keep_from when the
   // buffer is full and that frees at least half of it.
   void inflate_until(std::size_t end, std::size_t keep_from);

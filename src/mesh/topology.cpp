@@ -228,13 +228,17 @@ Topology build_topology(const Faces& F, Index num_vertices) {
     for (Index i = 0; i < edge_counts[static_cast<std::size_t>(v)]; ++i, ++e) t.edges(e, 0) = v, t.edges(e, 1) = source[i];
   });
   scratch_neighbours = std::vector<Index>();
+  // A vertex's edges are sorted by their other end: binary search, since one vertex can own
+  // O(n) edges (a triangulated comb's spine, a fan), and a scan made the face loop quadratic.
   auto find_edge = [&](Index a, Index b) {
     if (a > b) std::swap(a, b);
-    const Index* first = t.edges.data() + 2 * edge_offsets[static_cast<std::size_t>(a)];
-    for (Index e = edge_offsets[static_cast<std::size_t>(a)]; e < edge_offsets[static_cast<std::size_t>(a) + 1]; ++e, first += 2) {
-      if (first[1] == b) return e;
+    Index low = edge_offsets[static_cast<std::size_t>(a)], high = edge_offsets[static_cast<std::size_t>(a) + 1];
+    while (low < high) {
+      const Index middle = low + (high - low) / 2;
+      if (t.edges.data()[2 * static_cast<std::size_t>(middle) + 1] < b) low = middle + 1;
+      else high = middle;
     }
-    return Index{-1};  // unreachable: every face edge was recorded above
+    return low;  // every face edge was recorded above, so this is it
   };
 
   // Face -> edges, edge -> faces.
