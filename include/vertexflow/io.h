@@ -2,8 +2,10 @@
 // (ASCII, binary), each optionally gzip-compressed on input and output (`NAME.EXT.gz`).
 //
 // Reading produces a clean triangle mesh:
-// - polygons are triangulated (quads by the valid, better-shaped diagonal; larger polygons by a
-//   constrained Delaunay triangulation in their best-fit plane, so non-convex ones are right);
+// - polygons are triangulated (quads by the valid, better-shaped diagonal; larger simple
+//   polygons in their best-fit plane in O(n log n), by a monotone partition and Delaunay edge
+//   flips, so non-convex ones are right; the flips stop after 8n, so a long spiral may end
+//   short of Delaunay, still a valid triangulation; self-intersecting ones are fanned);
 // - STL's per-facet vertices are welded (bitwise-equal positions become one vertex);
 // - unreferenced vertices, faces with a repeated index, duplicate faces (same vertex set, any
 //   order or orientation) and zero-area faces (area < kDegenerateAreaRelative * diagonal^2) are
