@@ -69,7 +69,9 @@ void expect_one_line_error(const test::WatchedRun& run, const fs::path& file, co
   EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
   EXPECT_NE(run.err.find(file.string() + ": "), std::string::npos) << run.err;
   EXPECT_NE(run.err.find(fragment), std::string::npos) << run.err;
+#ifndef VERTEXFLOW_TEST_ASAN  // its shadow memory and quarantine add 100-200 MB (384 MB measured)
   EXPECT_LT(run.peak_rss_kb, kMaxRssKb) << run.err;
+#endif
 }
 
 TEST(GzipBomb, FiveGigabytesOfZerosFailAtTheHeader) {
