@@ -66,8 +66,7 @@ Mesh read_mesh_with_warnings(const std::filesystem::path& path, const GlobalOpti
 }
 
 std::string describe_format(const ReadReport& report) {
-  const char* names[] = {"OBJ", "PLY", "OFF", "STL"};
-  std::string s = names[static_cast<int>(report.format)];
+  std::string s = format_name(report.format);
   if (report.format != MeshFormat::Obj) s += report.binary ? " (binary)" : " (ASCII)";
   if (report.gzip) s += ", gzip";
   return s;

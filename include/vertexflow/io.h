@@ -40,6 +40,9 @@ class IoError : public std::runtime_error {
 
 enum class MeshFormat { Obj, Ply, Off, Stl };
 
+/// "OBJ", "PLY", "OFF" or "STL".
+const char* format_name(MeshFormat format);
+
 /// File format from the extension (case-insensitive, a trailing ".gz" ignored).
 /// Throws IoError for an unknown extension.
 MeshFormat format_from_path(const std::filesystem::path& path);

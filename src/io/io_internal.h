@@ -49,6 +49,10 @@ PolygonSoup parse_ply(ByteSource& source, const std::string& name, ReadReport& r
 PolygonSoup parse_off(ByteSource& source, const std::string& name, ReadReport& report);
 PolygonSoup parse_stl(ByteSource& source, const std::string& name, ReadReport& report);
 
+/// Whether `bytes` is exactly as long as the binary STL its header describes (80-byte comment,
+/// uint32 triangle count, 50 bytes per triangle): how a binary STL is recognised.
+bool has_binary_stl_size(std::string_view bytes);
+
 /// Validates the soup and turns it into a clean triangle mesh (see io.h for what is removed).
 Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& report,
                   const ReadOptions& options);

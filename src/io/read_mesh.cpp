@@ -372,8 +372,6 @@ MeshFormat format_from_path(const std::filesystem::path& path) {
                               : "unknown extension '" + ext + "'; expected .obj, .ply, .off or .stl (optionally .gz)");
 }
 
-namespace {
-
 const char* format_name(MeshFormat format) {
   switch (format) {
     case MeshFormat::Obj: return "OBJ";
@@ -383,8 +381,6 @@ const char* format_name(MeshFormat format) {
   }
   return "?";
 }
-
-}  // namespace
 
 std::vector<std::string> ReadReport::warnings() const {
   std::vector<std::string> out;
@@ -409,7 +405,8 @@ namespace {
 // The format the first bytes show, when they show one beyond doubt: "ply" on the first line, an
 // OFF keyword as the first token, or "solid" followed by "facet"/"endsolid" (ASCII STL). OBJ
 // has no signature. Binary STL is recognised by its size (84 + 50 x its triangle count).
-std::optional<MeshFormat> format_from_content(std::string_view head, bool complete, std::size_t total) {
+// `whole` is the complete content when it is all in memory (plain files), else empty.
+std::optional<MeshFormat> format_from_content(std::string_view head, std::string_view whole) {
   if (head.substr(0, 4) == "ply\n" || head.substr(0, 5) == "ply\r\n") return MeshFormat::Ply;
   const std::string no_name;
   io_detail::TextScanner in(head, no_name);
@@ -423,12 +420,7 @@ std::optional<MeshFormat> format_from_content(std::string_view head, bool comple
     const std::string_view second = in.token();
     if (second == "facet" || second == "endsolid") return MeshFormat::Stl;
   }
-  if (complete && total >= 84) {
-    std::uint32_t count = 0;
-    std::memcpy(&count, head.data() + 80, 4);
-    if (!io_detail::host_is_little_endian()) count = __builtin_bswap32(count);
-    if (84 + 50 * std::uint64_t{count} == total) return MeshFormat::Stl;
-  }
+  if (!whole.empty() && io_detail::has_binary_stl_size(whole)) return MeshFormat::Stl;
   return std::nullopt;
 }
 
@@ -445,7 +437,7 @@ Mesh read_mesh_checked(std::string_view bytes, MeshFormat format, const std::str
     source.request(kHeadBytes, 0);
     const std::string_view head = source.data().substr(0, kHeadBytes);
     if (head.empty()) io_detail::fail(name, "the file is empty");
-    const std::optional<MeshFormat> content = format_from_content(head, source.complete(), source.data().size());
+    const std::optional<MeshFormat> content = format_from_content(head, source.complete() ? source.data() : std::string_view());
     if (content && *content != format) {
       r.format = *content;
       r.format_differs_from_extension = true;

@@ -22,12 +22,19 @@ bool looks_ascii(std::string_view bytes) {
   std::size_t i = 0;
   while (i < bytes.size() && TextScanner::is_space(bytes[i])) ++i;
   if (bytes.substr(i, 5) != "solid") return false;
-  if (bytes.size() >= kBinaryHeader) {
-    const std::uint64_t count = load_scalar<std::uint32_t>(bytes.data() + 80, !host_is_little_endian());
-    if (kBinaryHeader + count * kBinaryRecord == bytes.size()) return false;
-  }
+  if (has_binary_stl_size(bytes)) return false;
   return bytes.substr(0, 4096).find('\0') == std::string_view::npos;
 }
+
+}  // namespace
+
+bool has_binary_stl_size(std::string_view bytes) {
+  if (bytes.size() < kBinaryHeader) return false;
+  const std::uint64_t count = load_scalar<std::uint32_t>(bytes.data() + 80, !host_is_little_endian());
+  return kBinaryHeader + count * kBinaryRecord == bytes.size();
+}
+
+namespace {
 
 PolygonSoup parse_ascii(std::string_view bytes, const std::string& name) {
   PolygonSoup soup;
