@@ -156,11 +156,11 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
   command->add_option("IN", o->input, "Input mesh (manifold)")->required();
   command->add_option("OUT", o->output, "Output mesh (same connectivity)")->required();
   command
-      ->add_option("--lambda", o->flow.lambda,
+      ->add_option("--lambda", o->flow.weights.lambda,
                    "Weight of the distance to the input: smaller moves vertices further (0.2 strong .. 50 faint)")
       ->check(CLI::PositiveNumber)
       ->capture_default_str();
-  command->add_option("--mu", o->flow.mu, "Weight of the fairness term")
+  command->add_option("--mu", o->flow.weights.mu, "Weight of the fairness term")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   command->add_option("--iterations", o->flow.iterations, "Solves, curvature recomputed in between")
@@ -174,7 +174,7 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
   command->add_flag("--no-projection", o->no_projection,
                     "Leave vertices where the solve puts them instead of moving them onto the input surface");
   command
-      ->add_option("--fairness", o->flow.fairness_target,
+      ->add_option("--fairness", o->flow.weights.fairness_target,
                    "Target of the fairness term: input-normal (default; keeps the shape) or zero (the paper's)")
       ->transform(
           CLI::CheckedTransformer(std::map<std::string, FairnessTarget>{{"input-normal", FairnessTarget::InputNormal},
@@ -230,7 +230,7 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
       phase(fmt::format("unsharp mask on {} vertices (weight {}, {} smoothing iterations)", mesh.num_vertices(),
                         o->unsharp.weight, o->unsharp.smoothing_iterations));
     else
-      phase(fmt::format("flowing {} vertices (lambda {}, mu {})", mesh.num_vertices(), o->flow.lambda, o->flow.mu));
+      phase(fmt::format("flowing {} vertices (lambda {}, mu {})", mesh.num_vertices(), o->flow.weights.lambda, o->flow.weights.mu));
     FlowResult result;
     try {
       result = unsharp ? unsharp_as_flow_result(mesh, o->unsharp) : vertex_flow(mesh.V, mesh.F, o->flow);
@@ -261,9 +261,9 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
       report["input"] = o->input;
       report["output"] = o->output;
       report["options"] = {
-          {"lambda", o->flow.lambda},
-          {"mu", o->flow.mu},
-          {"epsilon", o->flow.epsilon},
+          {"lambda", o->flow.weights.lambda},
+          {"mu", o->flow.weights.mu},
+          {"epsilon", o->flow.weights.epsilon},
           {"d_percentile", o->flow.d_percentile},
           {"iterations", o->flow.iterations},
           {"fix_boundary", o->flow.fix_boundary},
@@ -271,7 +271,7 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
           {"pinned", o->flow.pinned.size()},
           {"project_to_input", o->flow.project_to_input},
           {"feature_angle", o->flow.feature_angle},
-          {"fairness_target", o->flow.fairness_target == FairnessTarget::Zero ? "zero" : "input-normal"}};
+          {"fairness_target", o->flow.weights.fairness_target == FairnessTarget::Zero ? "zero" : "input-normal"}};
       report["seconds"] = {{"read", seconds_read},
                            {"curvature", r.seconds_curvature},
                            {"assembly", r.seconds_assembly},

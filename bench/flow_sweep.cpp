@@ -31,13 +31,13 @@ int main(int argc, char** argv) {
     const std::string k = s.substr(0, eq);
     const double v = std::atof(s.substr(eq + 1).c_str());
     if (k == "lambda")
-      o.lambda = v;
+      o.weights.lambda = v;
     else if (k == "mu")
-      o.mu = v;
+      o.weights.mu = v;
     else if (k == "dp")
       o.d_percentile = v;
     else if (k == "eps")
-      o.epsilon = v;
+      o.weights.epsilon = v;
     else if (k == "iters")
       o.iterations = static_cast<int>(v);
     else if (k == "proj")
@@ -47,7 +47,7 @@ int main(int argc, char** argv) {
     else if (k == "minq")
       o.min_quality = v;
     else if (k == "fair")
-      o.fairness_target = v != 0 ? FairnessTarget::InputNormal : FairnessTarget::Zero;
+      o.weights.fairness_target = v != 0 ? FairnessTarget::InputNormal : FairnessTarget::Zero;
     else {
       std::fprintf(stderr, "unknown %s\n", k.c_str());
       return 2;

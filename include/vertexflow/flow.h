@@ -22,6 +22,7 @@
 #include "vertexflow/curvature.h"
 #include "vertexflow/flow_energy.h"
 #include "vertexflow/mesh.h"
+#include "vertexflow/topology.h"
 
 #include <string>
 #include <vector>
@@ -60,19 +61,9 @@ enum class LinearSolver {
 };
 
 struct FlowOptions {
-  /// Weight of the distance term F_sd: the user's "strength" knob, inverted. Smaller lets the
-  /// vertices move further (stronger enhancement); useful range about 0.2 (strong) to 50
-  /// (almost no change); 1 is the paper's default.
-  double lambda = 1.0;
-  /// Weight of the fairness term F_smo (paper: 0.5). 0 removes it, which leaves flat regions
-  /// unconstrained (method-notes: "mu > 0 is required").
-  double mu = 0.5;
-  /// Isotropic pull towards the input, relative to lambda: keeps the system definite at flat
-  /// vertices, where neither F_em nor F_sd constrains tangential motion.
-  double epsilon = 1e-6;
-  /// What F_smo pulls the umbrella vectors towards (flow_energy.h): by default the input's
-  /// normal part, so that the fairness term evens out the sampling without shrinking the shape.
-  FairnessTarget fairness_target = FairnessTarget::InputNormal;
+  /// The weights of the energy's terms (flow_energy.h): lambda, the user's strength knob
+  /// (default 1), mu (0.5), epsilon (1e-6) and the fairness target (the input's normal part).
+  EnergyWeights weights;
   /// d of Eq. 6 is the principal curvature radius at this percentile of |k| (largest
   /// curvatures). 100 is the paper's literal "minimum radius of all vertices", which a single
   /// noisy vertex of a scan decides; 99 gives the same result on clean meshes and less drift
@@ -143,14 +134,21 @@ struct FlowResult {
   FlowReport report;
 };
 
-/// Moves the vertices of (V, F) by vertex flow. Throws std::invalid_argument for an empty or
-/// non-manifold mesh, or a pinned index out of range.
+/// Checks every option against its allowed range: lambda > 0, mu >= 0, epsilon > 0 (all
+/// finite), d_percentile in [0, 100], iterations >= 1, feature_angle >= 0, max_halvings >= 1,
+/// min_quality in [0, 1], solver_tolerance in (0, 1), curvature.smoothing_rounds >= 0, and
+/// (when num_vertices >= 0) every pinned index in [0, num_vertices). Throws
+/// std::invalid_argument naming the first option out of range and its allowed range.
+void validate_flow_options(const FlowOptions& options, Index num_vertices = -1);
+
+/// Moves the vertices of (V, F) by vertex flow. Throws std::invalid_argument for options out
+/// of range (validate_flow_options), an empty mesh, a non-finite coordinate, a mesh without
+/// extent, or a non-manifold mesh.
 FlowResult vertex_flow(const Vertices& V, const Faces& F, const FlowOptions& options = {});
 
-/// Faces whose normal turned by more than 90 degrees from `before` to `after` (same faces).
-std::vector<Index> flipped_faces(const Vertices& before, const Vertices& after, const Faces& F);
-
-/// Faces with area below kDegenerateAreaRelative * (bounding-box diagonal of V)^2.
-std::vector<Index> degenerate_faces(const Vertices& V, const Faces& F);
+/// The same with the topology of F (build_topology(F, V.rows())) computed by the caller, who
+/// may need it too: the flow builds none of its own. Throws std::invalid_argument if the
+/// topology was built for another vertex or face count.
+FlowResult vertex_flow(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options = {});
 
 }  // namespace vertexflow

@@ -57,11 +57,20 @@ enum class FairnessTarget {
   InputNormal,
 };
 
-/// Weights of the terms.
+/// Weights of the terms (Eq. 1).
 struct EnergyWeights {
-  double lambda = 1.0;    ///< weight of F_sd (Eq. 1)
-  double mu = 0.5;        ///< weight of F_smo (Eq. 1)
-  double epsilon = 1e-6;  ///< isotropic pull, relative to lambda
+  /// Weight of the distance term F_sd: the user's "strength" knob, inverted. Smaller lets the
+  /// vertices move further (stronger enhancement); useful range about 0.2 (strong) to 50
+  /// (almost no change); 1 is the paper's default. Must be > 0.
+  double lambda = 1.0;
+  /// Weight of the fairness term F_smo (paper: 0.5). 0 removes it, which leaves flat regions
+  /// unconstrained (docs/method-notes.md: "mu > 0 is required"). Must be >= 0.
+  double mu = 0.5;
+  /// Isotropic pull towards the input, relative to lambda: keeps the system definite at flat
+  /// vertices, where neither F_em nor F_sd constrains tangential motion. Must be > 0.
+  double epsilon = 1e-6;
+  /// What F_smo pulls the umbrella vectors towards: by default the input's normal part, so that
+  /// the fairness term evens out the sampling without shrinking the shape.
   FairnessTarget fairness_target = FairnessTarget::InputNormal;
 };
 

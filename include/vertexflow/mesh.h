@@ -80,6 +80,12 @@ BoundingBox bounding_box(const Vertices& V);
 /// Unnormalised normal of triangle f: (v1 - v0) x (v2 - v0), length twice the area.
 Eigen::Vector3d face_normal(const Vertices& V, const Faces& F, Index f);
 
+/// Faces whose normal turned by more than 90 degrees from `before` to `after` (same faces).
+std::vector<Index> flipped_faces(const Vertices& before, const Vertices& after, const Faces& F);
+
+/// Faces with area below kDegenerateAreaRelative * (bounding-box diagonal of V)^2.
+std::vector<Index> degenerate_faces(const Vertices& V, const Faces& F);
+
 /// Area of triangle f.
 double face_area(const Vertices& V, const Faces& F, Index f);
 

@@ -150,47 +150,53 @@ Vertices solve_once(const Vertices& X, const Faces& F, const Topology& topology,
   report.seconds_curvature += seconds_since(start);
 
   const Vertices Y =
-      solver.solve(frame, {options.lambda, options.mu, options.epsilon, options.fairness_target}, report);
+      solver.solve(frame, options.weights, report);
   if (!Y.allFinite()) throw std::runtime_error("vertex flow: the solver diverged");
   return Y;
 }
 
 }  // namespace
 
-std::vector<Index> flipped_faces(const Vertices& before, const Vertices& after, const Faces& F) {
-  std::vector<Index> out;
-  for (Index f = 0; f < F.rows(); ++f) {
-    if (face_normal(before, F, f).dot(face_normal(after, F, f)) < 0) out.push_back(f);
-  }
-  return out;
-}
-
-std::vector<Index> degenerate_faces(const Vertices& V, const Faces& F) {
-  const double diagonal = bounding_box(V).diagonal();
-  const double min_area = kDegenerateAreaRelative * diagonal * diagonal;
-  std::vector<Index> out;
-  for (Index f = 0; f < F.rows(); ++f) {
-    if (0.5 * face_normal(V, F, f).norm() < min_area) out.push_back(f);
-  }
-  return out;
+void validate_flow_options(const FlowOptions& o, Index num_vertices) {
+  auto require = [](bool ok, const char* what) {
+    if (!ok) throw std::invalid_argument(std::string("vertex flow: ") + what);
+  };
+  const EnergyWeights& w = o.weights;
+  require(std::isfinite(w.lambda) && w.lambda > 0, "lambda must be a finite number > 0");
+  require(std::isfinite(w.mu) && w.mu >= 0, "mu must be a finite number >= 0");
+  require(std::isfinite(w.epsilon) && w.epsilon > 0, "epsilon must be a finite number > 0");
+  require(o.d_percentile >= 0 && o.d_percentile <= 100, "d_percentile must be in [0, 100]");
+  require(o.iterations >= 1, "iterations must be at least 1");
+  require(o.feature_angle >= 0, "feature_angle must be >= 0 degrees (180 or more disables creases)");
+  require(o.max_halvings >= 1, "max_halvings must be at least 1");
+  require(o.min_quality >= 0 && o.min_quality <= 1, "min_quality must be in [0, 1]");
+  require(o.solver_tolerance > 0 && o.solver_tolerance < 1, "solver_tolerance must be in (0, 1)");
+  require(o.curvature.smoothing_rounds >= 0, "curvature.smoothing_rounds must be >= 0");
+  if (num_vertices < 0) return;
+  for (const Index p : o.pinned)
+    if (p < 0 || p >= num_vertices)
+      throw std::invalid_argument("vertex flow: pinned vertex " + std::to_string(p) + " is out of range [0, " +
+                                  std::to_string(num_vertices) + ")");
 }
 
 FlowResult vertex_flow(const Vertices& V, const Faces& F, const FlowOptions& options) {
+  validate_flow_options(options, static_cast<Index>(V.rows()));
+  if (V.rows() == 0 || F.rows() == 0) throw std::invalid_argument("vertex flow: the mesh is empty");
+  return vertex_flow(V, F, build_topology(F, static_cast<Index>(V.rows())), options);
+}
+
+FlowResult vertex_flow(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options) {
   const Index n = static_cast<Index>(V.rows());
+  validate_flow_options(options, n);
   if (n == 0 || F.rows() == 0) throw std::invalid_argument("vertex flow: the mesh is empty");
+  if (topology.num_vertices != n || topology.num_faces != static_cast<Index>(F.rows()))
+    throw std::invalid_argument("vertex flow: the topology was built for another mesh");
   if (!V.allFinite()) throw std::invalid_argument("vertex flow: a vertex has a non-finite coordinate");
   // The flow normalises by the mean edge length and judges faces relative to the diagonal; a
   // mesh without extent has neither.
   if (!(bounding_box(V).diagonal() > 0))
     throw std::invalid_argument(
         "vertex flow: the bounding box has zero size (all vertices at one point, or coordinates too small to compute with)");
-  if (!(options.d_percentile >= 0 && options.d_percentile <= 100))
-    throw std::invalid_argument("vertex flow: d_percentile must be in [0, 100]");
-  if (options.max_halvings < 1) throw std::invalid_argument("vertex flow: max_halvings must be at least 1");
-  if (!(options.feature_angle >= 0)) throw std::invalid_argument("vertex flow: feature_angle must be non-negative");
-  if (!(options.min_quality >= 0 && options.min_quality <= 1))
-    throw std::invalid_argument("vertex flow: min_quality must be in [0, 1]");
-  const Topology topology = build_topology(F, n);
   if (!topology.is_manifold()) throw std::invalid_argument("vertex flow: " + describe_non_manifold(topology));
   FlowResult result;
   FlowReport& report = result.report;
@@ -201,11 +207,7 @@ FlowResult vertex_flow(const Vertices& V, const Faces& F, const FlowOptions& opt
     if ((options.fix_boundary && topology.is_boundary_vertex[static_cast<std::size_t>(i)]) || topology.valence(i) == 0)
       fixed[static_cast<std::size_t>(i)] = 1;
   }
-  for (const Index p : options.pinned) {
-    if (p < 0 || p >= n)
-      throw std::invalid_argument("vertex flow: pinned vertex " + std::to_string(p) + " is out of range");
-    fixed[static_cast<std::size_t>(p)] = 1;
-  }
+  for (const Index p : options.pinned) fixed[static_cast<std::size_t>(p)] = 1;
   // Sharp features (only with the projection, which is what enforces them): corners stay.
   const SurfaceFeatures features =
       detect_features(V, F, topology, options.project_to_input ? options.feature_angle : 180.0);
@@ -226,7 +228,7 @@ FlowResult vertex_flow(const Vertices& V, const Faces& F, const FlowOptions& opt
   FlowSystemSolver solver(topology, fixed, options.solver, options.solver_tolerance);
   const GuardCriteria criteria = guard_criteria(input, F, options.min_quality);
   std::vector<char> shortened(static_cast<std::size_t>(n), 0);
-  for (int round = 0; round < std::max(1, options.iterations); ++round) {
+  for (int round = 0; round < options.iterations; ++round) {
     const Vertices start_of_round = X;
     X = solve_once(X, F, topology, solver, options, report);
     if (options.project_to_input) {

@@ -52,4 +52,22 @@ double signed_volume(const Vertices& V, const Faces& F) {
   return volume / 6.0;
 }
 
+std::vector<Index> flipped_faces(const Vertices& before, const Vertices& after, const Faces& F) {
+  std::vector<Index> out;
+  for (Index f = 0; f < F.rows(); ++f) {
+    if (face_normal(before, F, f).dot(face_normal(after, F, f)) < 0) out.push_back(f);
+  }
+  return out;
+}
+
+std::vector<Index> degenerate_faces(const Vertices& V, const Faces& F) {
+  const double diagonal = bounding_box(V).diagonal();
+  const double min_area = kDegenerateAreaRelative * diagonal * diagonal;
+  std::vector<Index> out;
+  for (Index f = 0; f < F.rows(); ++f) {
+    if (0.5 * face_normal(V, F, f).norm() < min_area) out.push_back(f);
+  }
+  return out;
+}
+
 }  // namespace vertexflow

@@ -2,7 +2,6 @@
 // (include/vertexflow/compare.h).
 #include "vertexflow/compare.h"
 
-#include "vertexflow/flow.h"
 #include "vertexflow/statistics.h"
 #include "vertexflow/topology.h"
 

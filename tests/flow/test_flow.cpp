@@ -13,6 +13,7 @@
 
 #include <chrono>
 #include <cstdlib>
+#include <functional>
 #include <future>
 #include <iostream>
 #include <limits>
@@ -179,10 +180,10 @@ TEST(FlowProjection, FairnessTargetKeepsTheIcosahedronStill) {
   // pulled inwards and the solid shrinks; with the default target the input is at rest.
   const Mesh ico = test::icosphere(1.0, 0);
   FlowOptions paper;
-  paper.fairness_target = FairnessTarget::Zero;
+  paper.weights.fairness_target = FairnessTarget::Zero;
   paper.project_to_input = false;
   FlowOptions ours = paper;
-  ours.fairness_target = FairnessTarget::InputNormal;
+  ours.weights.fairness_target = FairnessTarget::InputNormal;
   const double volume = signed_volume(ico.V, ico.F);
   EXPECT_LT(signed_volume(vertex_flow(ico.V, ico.F, paper).V, ico.F), 0.99 * volume);
   EXPECT_NEAR(signed_volume(vertex_flow(ico.V, ico.F, ours).V, ico.F), volume, 1e-9 * volume);
@@ -225,7 +226,7 @@ TEST(Flow, LargerLambdaMovesLess) {
   double previous = std::numeric_limits<double>::infinity();
   for (const double lambda : {0.2, 1.0, 10.0, 50.0}) {
     FlowOptions options;
-    options.lambda = lambda;
+    options.weights.lambda = lambda;
     const double moved = mean_displacement(vertex_flow(mesh.V, mesh.F, options).V, mesh.V);
     EXPECT_LT(moved, previous) << "lambda " << lambda;
     previous = moved;
@@ -284,6 +285,51 @@ TEST(Flow, RejectsInvalidOptionsAndRepeatedVertexFaces) {
   Faces bad = mesh.F;
   bad(0, 1) = bad(0, 0);
   EXPECT_THROW(vertex_flow(mesh.V, bad), std::invalid_argument);
+}
+
+// Every option out of its range is refused by the library itself (not only by the CLI), with
+// a message that names the option; the defaults are valid.
+TEST(Flow, ValidatesEveryOptionAndNamesIt) {
+  const Mesh mesh = test::icosphere(1.0, 0);
+  EXPECT_NO_THROW(validate_flow_options(FlowOptions{}, mesh.num_vertices()));
+  const double nan = std::nan("");
+  const std::vector<std::pair<std::string, std::function<void(FlowOptions&)>>> cases = {
+      {"lambda", [](FlowOptions& o) { o.weights.lambda = 0; }},
+      {"lambda", [](FlowOptions& o) { o.weights.lambda = -1; }},
+      {"lambda", [&](FlowOptions& o) { o.weights.lambda = nan; }},
+      {"mu", [](FlowOptions& o) { o.weights.mu = -0.5; }},
+      {"mu", [](FlowOptions& o) { o.weights.mu = std::numeric_limits<double>::infinity(); }},
+      {"epsilon", [](FlowOptions& o) { o.weights.epsilon = 0; }},
+      {"d_percentile", [](FlowOptions& o) { o.d_percentile = 101; }},
+      {"iterations", [](FlowOptions& o) { o.iterations = 0; }},
+      {"feature_angle", [&](FlowOptions& o) { o.feature_angle = nan; }},
+      {"max_halvings", [](FlowOptions& o) { o.max_halvings = 0; }},
+      {"min_quality", [](FlowOptions& o) { o.min_quality = 1.5; }},
+      {"solver_tolerance", [](FlowOptions& o) { o.solver_tolerance = 0; }},
+      {"smoothing_rounds", [](FlowOptions& o) { o.curvature.smoothing_rounds = -1; }},
+      {"pinned vertex 12", [](FlowOptions& o) { o.pinned = {0, 12}; }},
+      {"pinned vertex -1", [](FlowOptions& o) { o.pinned = {-1}; }},
+  };
+  for (const auto& [name, set] : cases) {
+    FlowOptions options;
+    set(options);
+    try {
+      vertex_flow(mesh.V, mesh.F, options);
+      ADD_FAILURE() << name << ": accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+    }
+  }
+}
+
+// The overload that takes the caller's topology gives the same bytes, and refuses a topology
+// of another mesh.
+TEST(Flow, TakesTheCallersTopology) {
+  const Mesh mesh = read_mesh(test::data_path("spot.obj"));
+  const Topology topology = build_topology(mesh.F, mesh.num_vertices());
+  EXPECT_EQ(vertex_flow(mesh.V, mesh.F, topology).V, vertex_flow(mesh.V, mesh.F).V);
+  const Mesh other = test::icosphere(1.0, 0);
+  EXPECT_THROW(vertex_flow(mesh.V, mesh.F, build_topology(other.F, other.num_vertices())), std::invalid_argument);
 }
 
 TEST(Flow, FacesDegenerateInTheInputDoNotStallTheGuard) {
