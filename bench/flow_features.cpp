@@ -1,6 +1,6 @@
-// Experiment (not a benchmark): what the flow's feature detection (surface_projection.h) marks on
+// Experiment (not a benchmark): what the flow's feature detection (vertexflow/features.h) marks on
 // a mesh: sharp edges, creases, corners and patches at a given feature angle.
-#include "../src/flow/surface_projection.h"
+#include "vertexflow/features.h"
 #include "vertexflow/curvature.h"
 #include "vertexflow/io.h"
 #include "vertexflow/topology.h"

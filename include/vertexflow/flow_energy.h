@@ -1,5 +1,6 @@
-// The energy of the vertex flow (paper sections 3-4), term by term, and its assembly as one
-// sparse linear least-squares system.
+// The energy of the vertex flow (paper sections 3-4), term by term, evaluated from the paper's
+// formulas. The flow minimises it through one encoding of the same terms as per-vertex 3x3
+// factors (src/flow/flow_terms.h), which the tests hold against these evaluations.
 //
 // Notation: V = current positions (the unknowns), P = the positions the solve starts from (the
 // input mesh M0, the proxy of the surface; with several iterations, the previous result), and
@@ -33,8 +34,6 @@
 #include "vertexflow/curvature.h"
 #include "vertexflow/mesh.h"
 #include "vertexflow/topology.h"
-
-#include <Eigen/SparseCore>
 
 namespace vertexflow {
 
@@ -94,16 +93,6 @@ double fairness_energy(const Vertices& V, const Topology& topology, const FlowFr
 /// The whole objective F_tan + lambda F_sd + mu F_smo + epsilon lambda / |V| sum |v - p|^2.
 double total_flow_energy(const Vertices& V, const Topology& topology, const FlowFrame& frame,
                          const EnergyWeights& weights);
-
-/// A linear least-squares system ||A x - b||^2 over x = (x_0, y_0, z_0, x_1, ...): 3 #V columns.
-struct LeastSquaresSystem {
-  Eigen::SparseMatrix<double, Eigen::RowMajor> A;
-  Eigen::VectorXd b;
-};
-
-/// Assembles the rows of every term (2 + 3 + 3 + 3 per vertex) so that ||A x - b||^2 equals
-/// total_flow_energy at the positions x.
-LeastSquaresSystem assemble_flow_system(const Topology& topology, const FlowFrame& frame, const EnergyWeights& weights);
 
 /// Coefficients c = d |k| / (d |k| + 1) of Eq. 6 for a curvature k (0 where k = 0).
 inline double distance_coefficient(double d, double k) {

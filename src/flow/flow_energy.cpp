@@ -1,6 +1,5 @@
 // The flow's energy terms (include/vertexflow/flow_energy.h), evaluated directly from the
-// paper's formulas and assembled as least-squares rows. The direct evaluations are what the
-// tests hold the assembly against.
+// paper's formulas: the reference the tests hold the solver's encoding (flow_terms.h) against.
 #include "vertexflow/flow_energy.h"
 
 #include <cmath>
@@ -103,88 +102,6 @@ double total_flow_energy(const Vertices& V, const Topology& topology, const Flow
   return tangential_edge_energy(V, topology, frame) + weights.lambda * squared_distance_energy(V, frame) +
          weights.mu * fairness_energy(V, topology, frame, weights.fairness_target) +
          weights.epsilon * weights.lambda * pull;
-}
-
-LeastSquaresSystem assemble_flow_system(const Topology& topology, const FlowFrame& frame,
-                                        const EnergyWeights& weights) {
-  const Index n = static_cast<Index>(frame.P.rows());
-  const Curvature& c = frame.curvature;
-  const double nv = std::max<double>(n, 1);
-  const double w_em = topology.num_edges() > 0 ? std::sqrt(1.0 / topology.num_edges()) : 0.0;
-  const double w_sd = std::sqrt(weights.lambda / nv);
-  const double w_pull = std::sqrt(weights.epsilon * weights.lambda / nv);
-
-  std::vector<Eigen::Triplet<double>> triplets;
-  triplets.reserve(static_cast<std::size_t>(n) * 60 + topology.ring_vertices.size() * 9);
-  std::vector<double> rhs;
-  rhs.reserve(static_cast<std::size_t>(n) * 11);
-  Index row = 0;
-  auto add_block_row = [&](Index r, Index vertex, const Eigen::RowVector3d& coefficients) {
-    for (int k = 0; k < 3; ++k) {
-      if (coefficients[k] != 0) triplets.emplace_back(r, 3 * vertex + k, coefficients[k]);
-    }
-  };
-
-  std::vector<Eigen::Matrix3d> K(static_cast<std::size_t>(n));
-  for (Index i = 0; i < n; ++i) K[static_cast<std::size_t>(i)] = c.absolute_tensor(i);
-
-  for (Index i = 0; i < n; ++i) {
-    const auto [begin, end] = topology.ring(i);
-    const Eigen::Vector3d t[2] = {row3(c.T1, i), row3(c.T2, i)};
-    const Eigen::Vector3d p = row3(frame.P, i);
-
-    // F_tan (Eq. 13-19): rows T_ia . g_i, with g_i = sum_j (K_i + K_j)(v_i - v_j).
-    for (const Eigen::Vector3d& ta : t) {
-      Eigen::RowVector3d own = Eigen::RowVector3d::Zero();
-      for (const Index* j = begin; j != end; ++j) {
-        const Eigen::RowVector3d coupling =
-            ta.transpose() * (K[static_cast<std::size_t>(i)] + K[static_cast<std::size_t>(*j)]);
-        own += coupling;
-        add_block_row(row, *j, -w_em * coupling);
-      }
-      add_block_row(row, i, w_em * own);
-      rhs.push_back(0.0);
-      ++row;
-    }
-
-    // lambda F_sd (Eq. 6-7): sqrt(c_a) T_a . (v - p) and N . (v - p).
-    const double coefficient[2] = {distance_coefficient(frame.d, c.k1[i]), distance_coefficient(frame.d, c.k2[i])};
-    for (int a = 0; a < 2; ++a) {
-      const double w = w_sd * std::sqrt(coefficient[a]);
-      add_block_row(row, i, w * t[a].transpose());
-      rhs.push_back(w * t[a].dot(p));
-      ++row;
-    }
-    const Eigen::Vector3d normal = row3(c.N, i);
-    add_block_row(row, i, w_sd * normal.transpose());
-    rhs.push_back(w_sd * normal.dot(p));
-    ++row;
-
-    // mu F_smo (Eq. 8-10): one row per coordinate.
-    if (begin != end) {
-      const double w = std::sqrt(weights.mu * fairness_weight(c, i) / nv);
-      const double share = w / static_cast<double>(end - begin);
-      const Eigen::Vector3d rest = fairness_rest(topology, frame, i, weights.fairness_target);
-      for (int k = 0; k < 3; ++k) {
-        triplets.emplace_back(row, 3 * i + k, w);
-        for (const Index* j = begin; j != end; ++j) triplets.emplace_back(row, 3 * *j + k, -share);
-        rhs.push_back(w * rest[k]);
-        ++row;
-      }
-    }
-
-    // The isotropic pull.
-    for (int k = 0; k < 3; ++k) {
-      triplets.emplace_back(row, 3 * i + k, w_pull);
-      rhs.push_back(w_pull * p[k]);
-      ++row;
-    }
-  }
-  LeastSquaresSystem system;
-  system.A.resize(row, 3 * n);
-  system.A.setFromTriplets(triplets.begin(), triplets.end());
-  system.b = Eigen::Map<const Eigen::VectorXd>(rhs.data(), static_cast<Eigen::Index>(rhs.size()));
-  return system;
 }
 
 }  // namespace vertexflow

@@ -1,11 +1,7 @@
-// Internal to the flow stage: solving the least-squares system of flow_energy.h. Kept apart
-// from flow.cpp (normalisation, curvature, guard) because it is the part whose algorithm
-// depends on the mesh size.
-//
-// Both solvers work on the displacement d = V - P from the input and on the normal equations
-// H d = b with H = A^T A (flow_energy.h's rows), b = A^T (rhs) - H P, rows and columns of the
-// fixed vertices removed (their d is 0). H is never formed by a sparse-sparse product: its
-// terms are products of per-vertex 3x3 blocks over one-rings (flow_solver.cpp).
+// Internal to the flow stage: minimising the energy of flow_energy.h for one frame, by solving
+// its normal equations H d = b (flow_terms.h) for the displacement d = V - P from the frame's
+// positions, rows and columns of the fixed vertices removed (their d is 0), with the method
+// that LinearSolver chooses (flow.h; flow_solver.cpp has the policy and its calibration).
 #pragma once
 
 #include "vertexflow/flow.h"

@@ -8,8 +8,8 @@ namespace vertexflow {
 
 void Mesh::set_vertex_property(std::string name, Eigen::VectorXd values) {
   if (values.size() != V.rows())
-    throw std::invalid_argument("vertex property '" + name + "' has " + std::to_string(values.size()) +
-                                " values for " + std::to_string(V.rows()) + " vertices");
+    throw std::invalid_argument("vertex property '" + name + "' has " + std::to_string(values.size()) + " values for " +
+                                std::to_string(V.rows()) + " vertices");
   for (auto& p : vertex_properties) {
     if (p.name == name) {
       p.values = std::move(values);
@@ -41,7 +41,9 @@ Eigen::Vector3d face_normal(const Vertices& V, const Faces& F, Index f) {
   return (b - a).cross(c - a);
 }
 
-double face_area(const Vertices& V, const Faces& F, Index f) { return 0.5 * face_normal(V, F, f).norm(); }
+double face_area(const Vertices& V, const Faces& F, Index f) {
+  return 0.5 * face_normal(V, F, f).norm();
+}
 
 double signed_volume(const Vertices& V, const Faces& F) {
   double volume = 0;

@@ -307,7 +307,10 @@ TEST(Flow, ValidatesEveryOptionAndNamesIt) {
       {"min_quality", [](FlowOptions& o) { o.min_quality = 1.5; }},
       {"solver_tolerance", [](FlowOptions& o) { o.solver_tolerance = 0; }},
       {"smoothing_rounds", [](FlowOptions& o) { o.curvature.smoothing_rounds = -1; }},
-      {"pinned vertex 12", [](FlowOptions& o) { o.pinned = {0, 12}; }},
+      {"pinned vertex 12",
+       [](FlowOptions& o) {
+         o.pinned = {0, 12};
+       }},
       {"pinned vertex -1", [](FlowOptions& o) { o.pinned = {-1}; }},
   };
   for (const auto& [name, set] : cases) {

@@ -1,14 +1,16 @@
 // The flow's linear solvers (src/flow/flow_solver.h): the direct factorisation against an
-// independent reference (A^T A of the assembled least-squares rows, Eigen's LDLT), the
+// independent reference (H probed through the operator, Eigen's LDLT), the
 // iterative paths (block-Jacobi and multilevel) against the direct one on real meshes (same
 // minimiser, same energy), the multilevel preconditioner's effect, the automatic choice and its
 // fallback, and identical bytes for any thread count.
 #include "shapes.h"
 #include "test_support.h"
 
+#include "flow_operator.h"
+#include "flow_setup.h"
 #include "flow_solver.h"
+#include "flow_terms.h"
 #include "vertexflow/io.h"
-#include "vertexflow/statistics.h"
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
@@ -16,12 +18,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 namespace vertexflow {
 namespace {
 
-// The problem vertex_flow solves, without its guard: scaled to mean edge length 1, boundary
-// vertices fixed.
+// The problem vertex_flow solves in its first round, without its projection and guard, set up
+// by the flow's own preparation (flow_setup.h): normalised to mean edge length 1, boundary and
+// corner vertices fixed.
 struct Problem {
   Mesh mesh;
   Topology topology;
@@ -33,15 +37,10 @@ Problem make_problem(Mesh mesh) {
   Problem p;
   p.mesh = std::move(mesh);
   p.topology = build_topology(p.mesh.F, p.mesh.num_vertices());
-  p.frame.P = (p.mesh.V.rowwise() - p.mesh.V.colwise().mean()) / mean_edge_length(p.mesh.V, p.topology);
-  p.frame.curvature = principal_curvatures(p.frame.P, p.mesh.F, p.topology);
-  std::vector<double> k(static_cast<std::size_t>(p.mesh.num_vertices()));
-  for (Index i = 0; i < p.mesh.num_vertices(); ++i)
-    k[static_cast<std::size_t>(i)] = std::max(std::abs(p.frame.curvature.k1[i]), std::abs(p.frame.curvature.k2[i]));
-  p.frame.d = 1.0 / percentile(k, 99.0);
-  p.fixed.assign(static_cast<std::size_t>(p.mesh.num_vertices()), 0);
-  for (Index i = 0; i < p.mesh.num_vertices(); ++i)
-    p.fixed[static_cast<std::size_t>(i)] = p.topology.is_boundary_vertex[static_cast<std::size_t>(i)] ? 1 : 0;
+  const FlowOptions options;
+  FlowSetup setup = prepare_flow(p.mesh.V, p.mesh.F, p.topology, options);
+  p.frame = flow_frame(setup.input, p.mesh.F, p.topology, options);
+  p.fixed = std::move(setup.fixed);
   return p;
 }
 
@@ -53,40 +52,46 @@ Vertices solve(const Problem& p, LinearSolver kind, const EnergyWeights& weights
   return Y;
 }
 
-// Minimiser of ||A x - b||^2 over the free coordinates, from the rows of flow_energy.h:
-// columns of fixed vertices moved to the right-hand side, then A^T A x = A^T b by LDLT.
+// The minimiser by a path independent of both solvers' machinery: H's columns over the free
+// coordinates probed with unit vectors through the operator (whose agreement with the paper's
+// formulas test_flow_energy.cpp checks), then H d = b by Eigen's sparse LDLT. The direct
+// solver assembles H from star sums instead (normal_matrix.h), the iterative ones never form it.
 Vertices reference_solution(const Problem& p, const EnergyWeights& weights) {
-  const LeastSquaresSystem system = assemble_flow_system(p.topology, p.frame, weights);
   const Index n = p.mesh.num_vertices();
-  std::vector<Index> column(3 * static_cast<std::size_t>(n), -1);
-  Index free_columns = 0;
+  std::vector<Index> order(static_cast<std::size_t>(n));
+  std::iota(order.begin(), order.end(), 0);
+  const FlowTerms terms = make_flow_terms(p.topology, p.fixed, p.frame, weights, order);
+  FlowOperator op(terms);
+  const BlockVector b = op.right_hand_side(to_local(terms, p.frame.P.data()));
+  std::vector<Eigen::Index> column(3 * static_cast<std::size_t>(n), -1);
+  std::vector<Eigen::Index> coordinate;  // free column -> coordinate
   for (Index i = 0; i < n; ++i)
     for (int k = 0; k < 3; ++k)
-      if (!p.fixed[static_cast<std::size_t>(i)]) column[3 * static_cast<std::size_t>(i) + k] = free_columns++;
-  Eigen::VectorXd rhs = system.b;
-  std::vector<Eigen::Triplet<double>> triplets;
-  for (Eigen::Index r = 0; r < system.A.outerSize(); ++r) {
-    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(system.A, r); it; ++it) {
-      const Index c = column[static_cast<std::size_t>(it.col())];
-      if (c >= 0) {
-        triplets.emplace_back(static_cast<Index>(r), c, it.value());
-      } else {
-        rhs[r] -= it.value() * p.frame.P(it.col() / 3, it.col() % 3);
+      if (!p.fixed[static_cast<std::size_t>(i)]) {
+        column[3 * static_cast<std::size_t>(i) + k] = static_cast<Eigen::Index>(coordinate.size());
+        coordinate.push_back(3 * i + k);
       }
+  const auto m = static_cast<Eigen::Index>(coordinate.size());
+  std::vector<Eigen::Triplet<double>> triplets;
+  BlockVector unit = BlockVector::Zero(3 * n), h(3 * n);
+  for (Eigen::Index c = 0; c < m; ++c) {
+    unit[coordinate[static_cast<std::size_t>(c)]] = 1;
+    op.apply(unit, h);
+    unit[coordinate[static_cast<std::size_t>(c)]] = 0;
+    for (Eigen::Index r = 0; r < h.size(); ++r) {
+      const Eigen::Index row = column[static_cast<std::size_t>(r)];
+      if (h[r] != 0 && row >= 0) triplets.emplace_back(row, c, h[r]);
     }
   }
-  Eigen::SparseMatrix<double> A(system.A.rows(), free_columns);
-  A.setFromTriplets(triplets.begin(), triplets.end());
-  const Eigen::SparseMatrix<double> AtA = Eigen::SparseMatrix<double>(A.transpose()) * A;
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(AtA);
+  Eigen::SparseMatrix<double> H(m, m);
+  H.setFromTriplets(triplets.begin(), triplets.end());
+  Eigen::VectorXd rhs(m);
+  for (Eigen::Index c = 0; c < m; ++c) rhs[c] = b[coordinate[static_cast<std::size_t>(c)]];
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt(H);
   EXPECT_EQ(ldlt.info(), Eigen::Success);
-  const Eigen::VectorXd x = ldlt.solve(A.transpose() * rhs);
+  const Eigen::VectorXd x = ldlt.solve(rhs);
   Vertices Y = p.frame.P;
-  for (Index i = 0; i < n; ++i)
-    for (int k = 0; k < 3; ++k) {
-      const Index c = column[3 * static_cast<std::size_t>(i) + k];
-      if (c >= 0) Y(i, k) = x[c];
-    }
+  for (Eigen::Index c = 0; c < m; ++c) Y.data()[coordinate[static_cast<std::size_t>(c)]] += x[c];
   return Y;
 }
 
@@ -94,7 +99,7 @@ double max_difference(const Vertices& a, const Vertices& b) {
   return (a - b).cwiseAbs().maxCoeff();
 }
 
-TEST(FlowSolver, BothPathsMatchTheLeastSquaresReference) {
+TEST(FlowSolver, AllPathsMatchTheProbedReference) {
   // hemisphere: a boundary (fixed vertices); both fairness targets.
   const Problem p = make_problem(read_mesh(test::data_path("hemisphere.off")));
   for (const FairnessTarget target : {FairnessTarget::InputNormal, FairnessTarget::Zero}) {

@@ -1,7 +1,7 @@
 // The smoothed-aggregation pieces behind LinearSolver::Multilevel (src/flow/multigrid.h):
 // aggregation of a graph, and the additive multilevel operator as a preconditioner of a
 // bi-Laplacian, the operator whose slow modes it exists for.
-#include "multigrid.h"
+#include "numerics/multigrid.h"
 
 #include <gtest/gtest.h>
 #include <Eigen/Sparse>

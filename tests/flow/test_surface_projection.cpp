@@ -1,6 +1,6 @@
 // Feature detection of the flow's projection (src/flow/surface_projection.h): which sharp edges
 // are creases, which vertices are corners.
-#include "surface_projection.h"
+#include "vertexflow/features.h"
 #include "test_support.h"
 
 #include "vertexflow/io.h"

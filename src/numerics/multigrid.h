@@ -1,6 +1,6 @@
-// Internal to the flow stage: an additive multilevel preconditioner built by smoothed
-// aggregation, for symmetric positive definite matrices of 3x3 blocks (x, y, z of one node).
-// flow_solver.cpp uses it on the coarse problem of LinearSolver::Multilevel.
+// Internal: an additive multilevel preconditioner built by smoothed aggregation, for symmetric
+// positive definite matrices of 3x3 blocks (x, y, z of one node). The flow uses it on the
+// coarse problem of LinearSolver::Multilevel (aggregation_coarse_space.h).
 //
 // Written here because no Debian package offers algebraic multigrid outside MPI stacks
 // (hypre, PETSc, Trilinos), and AMGCL, the header-only reference for the method, is not

@@ -1,4 +1,7 @@
-#include "multigrid.h"
+#include "numerics/multigrid.h"
+
+#include "numerics/block3.h"
+#include "numerics/parallel.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -22,26 +25,13 @@ constexpr double kStrengthThreshold = 0.08;
 // Power iterations for the spectral radius of B A in the prolongator's damping.
 constexpr int kPowerIterations = 12;
 
-// Rows in parallel, or in the calling thread when there are few: the coarse levels are applied
-// once per outer iteration, and for a few hundred rows starting tasks cost more than the rows.
+// Rows in the calling thread below this many: the coarse levels are applied once per outer
+// iteration, and for a few hundred rows starting tasks cost more than the rows.
 constexpr int kSerialBelow = 2048;
 
 template <class Body>
 void parallel_rows(int rows, Body&& body) {
-  if (rows < kSerialBelow) {
-    for (int k = 0; k < rows; ++k) body(k);
-    return;
-  }
-  tbb::parallel_for(tbb::blocked_range<int>(0, rows, 128), [&](const tbb::blocked_range<int>& range) {
-    for (int k = range.begin(); k != range.end(); ++k) body(k);
-  });
-}
-
-Eigen::Map<const Vector3> at(const Eigen::VectorXd& v, int k) {
-  return Eigen::Map<const Vector3>(v.data() + 3 * k);
-}
-Eigen::Map<Vector3> at(Eigen::VectorXd& v, int k) {
-  return Eigen::Map<Vector3>(v.data() + 3 * k);
+  parallel_for_index(rows, body, 128, kSerialBelow);
 }
 
 BlockSparseMatrix transpose(const BlockSparseMatrix& A) {
@@ -103,7 +93,7 @@ double spectral_radius(const std::vector<Matrix3>& inverse_diagonal, const Block
   double lambda = 1;
   for (int iteration = 0; iteration < kPowerIterations; ++iteration) {
     A.multiply(v, w);
-    for (int k = 0; k < A.rows; ++k) at(w, k) = inverse_diagonal[static_cast<std::size_t>(k)] * at(w, k);
+    for (int k = 0; k < A.rows; ++k) block_at(w, k) = inverse_diagonal[static_cast<std::size_t>(k)] * block_at(w, k);
     lambda = w.norm() / v.norm();
     v = w / w.norm();
   }
@@ -177,8 +167,8 @@ void BlockSparseMatrix::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) c
   parallel_rows(rows, [&](int k) {
     Vector3 sum = Vector3::Zero();
     for (int m = start[static_cast<std::size_t>(k)]; m < start[static_cast<std::size_t>(k) + 1]; ++m)
-      sum.noalias() += block[static_cast<std::size_t>(m)] * at(x, column[static_cast<std::size_t>(m)]);
-    at(y, k) = sum;
+      sum.noalias() += block[static_cast<std::size_t>(m)] * block_at(x, column[static_cast<std::size_t>(m)]);
+    block_at(y, k) = sum;
   });
 }
 
@@ -307,7 +297,8 @@ void AdditiveMultilevel::apply(std::size_t index, const Eigen::VectorXd& b, Eige
   level.R.multiply(b, restricted);
   apply(index + 1, restricted, coarse);
   level.P.multiply(coarse, x);
-  parallel_rows(level.P.rows, [&](int k) { at(x, k) += level.block_inverse[static_cast<std::size_t>(k)] * at(b, k); });
+  parallel_rows(level.P.rows,
+                [&](int k) { block_at(x, k) += level.block_inverse[static_cast<std::size_t>(k)] * block_at(b, k); });
 }
 
 }  // namespace vertexflow

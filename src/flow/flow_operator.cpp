@@ -1,0 +1,185 @@
+#include "flow_operator.h"
+
+#include "numerics/parallel.h"
+
+#include <tbb/enumerable_thread_specific.h>
+
+#include <algorithm>
+#include <cstdint>
+
+namespace vertexflow {
+namespace {
+
+// What a vertex reads of its neighbours is interleaved in one record per vertex, so that a
+// neighbour costs one or two cache lines instead of one per array: the gathers' cache misses
+// were the hot spots of both one-ring passes.
+template <int Size>
+Eigen::Map<Eigen::Matrix<double, Size, 1>> record(std::vector<double>& data, Index i) {
+  return Eigen::Map<Eigen::Matrix<double, Size, 1>>(data.data() + Size * static_cast<std::size_t>(i));
+}
+
+// What vertex i contributes to the Galerkin matrix for aggregate `aggregate`.
+struct Local {
+  Index aggregate;
+  double phi;         // phi_a(i)
+  Eigen::Matrix3d g;  // (G Phi_a)_i
+  double l;           // (L phi_a)_i
+};
+
+}  // namespace
+
+FlowOperator::FlowOperator(const FlowTerms& terms) : t_(terms) {
+  const auto n = static_cast<std::size_t>(t_.n);
+  xkx_.resize(6 * n);
+  qkr_.resize(9 * n);
+  r_.resize(3 * static_cast<Eigen::Index>(n));
+}
+
+double FlowOperator::apply(const BlockVector& x, BlockVector& y) {
+  return passes(x, y, true, false, [&](Index i) -> Eigen::Vector3d { return block_at(x, i); });
+}
+
+double FlowOperator::apply_updated(BlockVector& p, const BlockVector& z, double beta, BlockVector& y) {
+  return passes(p, y, true, false, [&](Index i) -> Eigen::Vector3d {
+    const Eigen::Vector3d updated = block_at(z, i) + beta * block_at(p, i);
+    block_at(p, i) = updated;
+    return updated;
+  });
+}
+
+BlockVector FlowOperator::right_hand_side(const BlockVector& x) {
+  BlockVector b(x.size());
+  passes(x, b, false, true, [&](Index i) -> Eigen::Vector3d { return block_at(x, i); });
+  b = -b;
+  return b;
+}
+
+// first(i) gives x_i (and may write it) in the first pass; the later passes read x.
+template <class First>
+double FlowOperator::passes(const BlockVector& x, BlockVector& y, bool with_d, bool with_rest, First&& first) {
+  parallel_for_index(t_.n, [&](Index i) {
+    const Eigen::Vector3d xi = first(i);
+    record<6>(xkx_, i).head<3>() = xi;
+    record<6>(xkx_, i).tail<3>() = t_.K[static_cast<std::size_t>(i)] * xi;
+  });
+  parallel_for_index(t_.n, [&](Index i) {
+    const auto v = static_cast<std::size_t>(i);
+    const auto [begin, end] = t_.one_ring(i);
+    Eigen::Matrix<double, 6, 1> sum = Eigen::Matrix<double, 6, 1>::Zero();
+    for (const Index* j = begin; j != end; ++j) sum += record<6>(xkx_, *j);
+    const Eigen::Vector3d xi = block_at(x, i), sum_x = sum.head<3>();
+    const Eigen::Vector3d q = t_.P[v] * Eigen::Vector3d(t_.G[v] * xi - t_.K[v] * sum_x - sum.tail<3>());
+    Eigen::Vector3d laplacian = xi - t_.inv_degree[v] * sum_x;
+    if (with_rest) laplacian -= t_.rest[v];
+    const Eigen::Vector3d r = t_.smooth[v] * laplacian;
+    auto out = record<9>(qkr_, i);
+    out.head<3>() = q;
+    out.segment<3>(3) = t_.K[v] * q;
+    out.tail<3>() = t_.inv_degree[v] * r;
+    block_at(r_, i) = r;
+  });
+  // y = G q + L^T r (+ D x), G symmetric.
+  return sum_over_vertices(t_.n, 0.0, [&](Index u) {
+    const auto v = static_cast<std::size_t>(u);
+    if (t_.fixed[v]) {
+      block_at(y, u).setZero();
+      return 0.0;
+    }
+    const auto [begin, end] = t_.one_ring(u);
+    Eigen::Matrix<double, 9, 1> sum = Eigen::Matrix<double, 9, 1>::Zero();
+    for (const Index* j = begin; j != end; ++j) sum += record<9>(qkr_, *j);
+    const Eigen::Vector3d xu = block_at(x, u), qu = record<9>(qkr_, u).head<3>();
+    Eigen::Vector3d out =
+        t_.G[v] * qu - t_.K[v] * Eigen::Vector3d(sum.head<3>()) - sum.segment<3>(3) + block_at(r_, u) - sum.tail<3>();
+    if (with_d) out += t_.D[v] * xu;
+    block_at(y, u) = out;
+    return xu.dot(out);
+  });
+}
+
+BlockSparseMatrix galerkin_upper(const FlowTerms& t, const AggregationCoarseSpace& space) {
+  const auto n = static_cast<std::size_t>(t.n);
+  // Per vertex i (the rows of A at i, fixed vertices included): for each aggregate a whose
+  // basis function is non-zero on the star of i, phi_a(i), the 3x3 block (G Phi_a)_i and the
+  // entry (L phi_a)_i.
+  // Sizes first (the distinct aggregates of the star's basis functions), so that the locals
+  // take what they need: reserving the worst case per vertex tripled amo's peak memory.
+  std::vector<std::uint32_t> local_size(n, 0);
+  tbb::enumerable_thread_specific<std::vector<Index>> seen;
+  parallel_for_index(t.n, [&](Index i) {
+    std::vector<Index>& aggregates = seen.local();  // distinct, a handful: linear search
+    aggregates.clear();
+    t.for_each_in_star(i, [&](Index u) {
+      for (const AggregationCoarseSpace::Weight& w : space.basis(u))
+        if (std::find(aggregates.begin(), aggregates.end(), w.aggregate) == aggregates.end())
+          aggregates.push_back(w.aggregate);
+    });
+    local_size[static_cast<std::size_t>(i)] = static_cast<std::uint32_t>(aggregates.size());
+  });
+  std::vector<std::size_t> local_start(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) local_start[i + 1] = local_start[i] + local_size[i];
+  std::vector<Local> locals(local_start[n]);
+  parallel_for_index(t.n, [&](Index i) {
+    const auto v = static_cast<std::size_t>(i);
+    Local* out = locals.data() + local_start[v];
+    std::uint32_t size = 0;
+    auto find = [&](Index a) -> Local& {
+      for (std::uint32_t k = 0; k < size; ++k)
+        if (out[k].aggregate == a) return out[k];
+      out[size] = Local{a, 0, Eigen::Matrix3d::Zero(), 0};
+      return out[size++];
+    };
+    const Eigen::Matrix3d G = t.G[v].full(), K = t.K[v].full();
+    for (const AggregationCoarseSpace::Weight& w : space.basis(i)) {
+      Local& x = find(w.aggregate);
+      x.phi = w.value;
+      x.g += w.value * G;
+      x.l += w.value;
+    }
+    const auto [begin, end] = t.one_ring(i);
+    for (const Index* j = begin; j != end; ++j) {
+      const Eigen::Matrix3d coupling = K + t.K[static_cast<std::size_t>(*j)].full();
+      for (const AggregationCoarseSpace::Weight& w : space.basis(*j)) {
+        Local& x = find(w.aggregate);
+        x.g -= w.value * coupling;
+        x.l -= t.inv_degree[v] * w.value;
+      }
+    }
+    std::sort(out, out + size, [](const Local& x, const Local& y) { return x.aggregate < y.aggregate; });
+  });
+  // The locals of each aggregate, by vertex (counting sort, so in vertex order).
+  const auto na = static_cast<std::size_t>(space.size());
+  std::vector<std::size_t> touch_start(na + 1, 0);
+  for (std::size_t i = 0; i < n; ++i)
+    for (std::size_t k = 0; k < local_size[i]; ++k)
+      ++touch_start[static_cast<std::size_t>(locals[local_start[i] + k].aggregate) + 1];
+  for (std::size_t a = 0; a < na; ++a) touch_start[a + 1] += touch_start[a];
+  std::vector<std::pair<Index, std::uint32_t>> touches(touch_start[na]);
+  {
+    std::vector<std::size_t> fill(touch_start.begin(), touch_start.end() - 1);
+    for (std::size_t i = 0; i < n; ++i)
+      for (std::uint32_t k = 0; k < local_size[i]; ++k)
+        touches[fill[static_cast<std::size_t>(locals[local_start[i] + k].aggregate)]++] = {static_cast<Index>(i), k};
+  }
+  // Row a of the upper half of H_c: blocks (a, b), b >= a, summed over the vertices in order.
+  return build_block_rows(space.size(), space.size(), [&](int a, BlockRowAccumulator& row) {
+    for (std::size_t m = touch_start[static_cast<std::size_t>(a)]; m < touch_start[static_cast<std::size_t>(a) + 1];
+         ++m) {
+      const auto [i, k] = touches[m];
+      const auto v = static_cast<std::size_t>(i);
+      const Local* local = locals.data() + local_start[v];
+      const Local& x = local[k];
+      const Eigen::Matrix3d left = x.g * t.P[v].full();
+      const Eigen::Matrix3d D = t.D[v].full();             // phi is 0 at fixed vertices, so their D drops out
+      for (std::uint32_t q = k; q < local_size[v]; ++q) {  // sorted, so local[q].aggregate >= a
+        const Local& y = local[q];
+        Eigen::Matrix3d& block = row[y.aggregate];
+        block.noalias() += left * y.g;
+        block.diagonal().array() += t.smooth[v] * x.l * y.l;
+        block.noalias() += (x.phi * y.phi) * D;
+      }
+    }
+  });
+}
+
+}  // namespace vertexflow

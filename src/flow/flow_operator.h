@@ -1,0 +1,45 @@
+// Internal to the flow stage: H of flow_terms.h applied without forming it, and its projection
+// onto a coarse space (the Galerkin matrix of LinearSolver::Multilevel).
+#pragma once
+
+#include "flow_terms.h"
+#include "numerics/aggregation_coarse_space.h"
+#include "numerics/conjugate_gradients.h"
+#include "numerics/multigrid.h"
+
+namespace vertexflow {
+
+/// H x without forming H: a pointwise pass (K x), then two passes over the one-rings: q = P G x
+/// and r = S (L x - R) (the weighted rows of F_tan and F_smo) with K q; then G q + L^T r + D x.
+/// The per-vertex factors are stored as symmetric 3x3 (48 bytes) and the dot product x . y that
+/// conjugate gradients need is summed in the last pass: about a third fewer bytes per iteration
+/// than full 3x3 blocks and separate passes, while applying K once per vertex and pass (applying
+/// it per neighbour instead, with no K x array, saved more bytes but cost more time: the
+/// iteration is as much bound by arithmetic as by memory here). Rows of fixed vertices are zero.
+class FlowOperator : public BlockOperator {
+ public:
+  explicit FlowOperator(const FlowTerms& terms);
+
+  double apply(const BlockVector& x, BlockVector& y) override;
+  double apply_updated(BlockVector& p, const BlockVector& z, double beta, BlockVector& y) override;
+
+  /// b = -(G P G x + L^T S (L x - R)) at x = the frame's positions (local order): the negative
+  /// half-gradient of the energy at d = 0, the normal equations' right-hand side (D drops out).
+  BlockVector right_hand_side(const BlockVector& x);
+
+ private:
+  template <class First>
+  double passes(const BlockVector& x, BlockVector& y, bool with_d, bool with_rest, First&& first);
+
+  const FlowTerms& t_;
+  std::vector<double> xkx_;  // per vertex: x, K x
+  std::vector<double> qkr_;  // per vertex: q, K q, r / degree
+  BlockVector r_;
+};
+
+/// The upper half (diagonal included) of the Galerkin matrix Phi^T H Phi, summed vertex by
+/// vertex from H's factors rather than through H: (G Phi)^T P (G Phi) + (L Phi)^T S (L Phi) (x)
+/// I + Phi^T D Phi.
+BlockSparseMatrix galerkin_upper(const FlowTerms& terms, const AggregationCoarseSpace& space);
+
+}  // namespace vertexflow

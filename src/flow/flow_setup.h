@@ -1,0 +1,37 @@
+// Internal to the flow stage: what vertex_flow prepares before its solves (the fixed vertices,
+// the features, the normalised copy) and the frozen data of each solve (the frame). Tests set
+// up the solver's problems through these, so that they test the problem the flow solves.
+#pragma once
+
+#include "vertexflow/features.h"
+#include "vertexflow/flow.h"
+#include "vertexflow/flow_energy.h"
+#include "vertexflow/topology.h"
+
+#include <vector>
+
+namespace vertexflow {
+
+struct FlowSetup {
+  /// Held at the input: boundary vertices (when options.fix_boundary), isolated vertices (no
+  /// energy terms but the pull), pinned vertices and the corners of the features.
+  std::vector<char> fixed;
+  /// Sharp features for options.feature_angle, or none without the projection (which is what
+  /// enforces them).
+  SurfaceFeatures features;
+  /// The normalisation (flow.h, "Scale and rigid motion"): input = (V - centroid) / scale, with
+  /// scale the mean edge length (1 if that is 0).
+  Eigen::RowVector3d centroid = Eigen::RowVector3d::Zero();
+  double scale = 1;
+  double mean_edge_length = 0;
+  Vertices input;
+};
+
+/// The preparation of vertex_flow for valid options and a valid mesh.
+FlowSetup prepare_flow(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options);
+
+/// The frame of one solve at positions X (normalised units): X, its curvature
+/// (options.curvature) and the radius d of Eq. 6 at options.d_percentile.
+FlowFrame flow_frame(const Vertices& X, const Faces& F, const Topology& topology, const FlowOptions& options);
+
+}  // namespace vertexflow

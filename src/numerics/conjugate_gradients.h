@@ -1,0 +1,85 @@
+// Internal: preconditioned conjugate gradients on a matrix-free symmetric positive definite
+// operator over 3-blocks, with a Lanczos estimate of the iterations still needed.
+//
+// The operator and the preconditioner's coarse part are interfaces, so that the problem (the
+// flow's normal equations, src/flow/flow_operator.h) stays apart from the iteration. What the
+// iteration needs besides the product is fused into the passes over the vectors: the operator
+// returns x . Hx from its last pass, and may do conjugate gradients' direction update in its
+// first; the block-Jacobi step and the two dot products share one pass. The iteration is
+// bound by memory traffic, and each separate pass costs a sweep over all vectors.
+#pragma once
+
+#include "numerics/block3.h"
+
+#include <optional>
+#include <vector>
+
+namespace vertexflow {
+
+/// A symmetric positive (semi-)definite operator on BlockVectors of `size()` blocks.
+class BlockOperator {
+ public:
+  virtual ~BlockOperator() = default;
+  /// y = H x; returns x . y (summed deterministically).
+  virtual double apply(const BlockVector& x, BlockVector& y) = 0;
+  /// p = z + beta p, then y = H p; returns p . y. Lets the direction update ride on the
+  /// operator's first pass.
+  virtual double apply_updated(BlockVector& p, const BlockVector& z, double beta, BlockVector& y) = 0;
+};
+
+/// An additive correction to the block-Jacobi preconditioner, M = B + C.
+class PreconditionerCorrection {
+ public:
+  virtual ~PreconditionerCorrection() = default;
+  /// z += C r; returns r . z (summed deterministically, z after the update).
+  virtual double add_to(const BlockVector& r, BlockVector& z) = 0;
+};
+
+/// Result of ConjugateGradients::run.
+struct IterationResult {
+  int iterations = 0;
+  bool converged = false;
+};
+
+/// Preconditioned conjugate gradients for H d = b from d = 0, preconditioned by the inverses of
+/// H's 3x3 diagonal blocks (zero blocks for unknowns held at 0) plus an optional correction.
+/// Results are the same for any thread count.
+class ConjugateGradients {
+ public:
+  /// `block_inverse[i]`: the inverse of H's diagonal block i, or zero where row i is held.
+  /// `op`, `b` and `correction` must outlive the iteration.
+  ConjugateGradients(BlockOperator& op, std::vector<Sym3> block_inverse, const BlockVector& b,
+                     PreconditionerCorrection* correction = nullptr);
+
+  /// Continues for at most max_iterations, stopping when |r| <= tolerance |b|.
+  IterationResult run(int max_iterations, double tolerance);
+
+  /// The iterations that the current preconditioner is predicted to need in all, from the
+  /// extreme eigenvalues of the Lanczos matrix of the iterations so far (Saad, Iterative
+  /// Methods, 6.7.3): 1/2 sqrt(kappa) ln(2 / tolerance), the conjugate-gradient bound. After a
+  /// few dozen iterations the smallest eigenvalue is still overestimated, so this is a lower
+  /// bound, and slow (flat) problems are underestimated most.
+  [[nodiscard]] double predicted_iterations(double tolerance) const;
+
+  /// Continues from the current iterate with another correction (a restart: the search
+  /// directions so far were conjugate for the old preconditioner).
+  void use_correction(PreconditionerCorrection* correction);
+
+  [[nodiscard]] const BlockVector& solution() const { return d_; }
+  [[nodiscard]] int total_iterations() const { return total_iterations_; }
+
+ private:
+  double precondition();  // z = B r (+ C r); returns r . z
+
+  BlockOperator& op_;
+  PreconditionerCorrection* correction_;  // null: block-Jacobi alone
+  std::optional<double> pending_beta_;    // p = z + beta p, done by the next operator application
+  std::vector<double> alphas_, betas_;    // of the iterations since the last preconditioner change
+  std::vector<Sym3> inverse_;
+  Index blocks_ = 0;
+  BlockVector d_, r_, z_, p_, hp_;
+  double rz_ = 0, b_norm_ = 0, r_norm_ = 0;
+  int total_iterations_ = 0;
+};
+
+}  // namespace vertexflow

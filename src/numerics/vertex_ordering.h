@@ -1,0 +1,27 @@
+// Internal: vertex orderings that keep a mesh's neighbours close in memory.
+//
+// The flow's operator gathers over one-rings; in a mesh's own order the neighbours of a vertex
+// can be anywhere in memory (subdivided meshes, amo.off). Measured: the iteration took 2-3x
+// longer per vertex on those meshes than on one whose file order is local (horse-48k).
+#pragma once
+
+#include "vertexflow/mesh.h"
+#include "vertexflow/topology.h"
+
+#include <vector>
+
+namespace vertexflow {
+
+/// Vertices sorted by the Morton code of their position (21 bits per axis), ties by index.
+std::vector<Index> space_filling_order(const Vertices& P);
+
+/// Breadth-first (Cuthill-McKee) order of the vertex graph, each component started from its
+/// first vertex in `seed_order`. Started from the Morton order (a vertex near a corner of the
+/// bounding box) the breadth-first levels stay short, so every neighbour of a vertex is within
+/// about one level's width of it in memory, a few hundred to a few thousand vertices, and the
+/// one-ring gathers stay in the L2 cache; in Morton order a fraction of them jump far (the
+/// curve's seams). Measured per iteration of the flow's solver, 1 thread: amo 11.6 -> 8.5 ms;
+/// armadillo-1M, 2 threads: 126 -> 77 ms.
+std::vector<Index> breadth_first_order(const Topology& topology, const std::vector<Index>& seed_order);
+
+}  // namespace vertexflow
