@@ -13,7 +13,7 @@
 namespace vertexflow::cli {
 
 nlohmann::json flow_metrics(const Vertices& input, const Vertices& result, const Faces& F) {
-  // The definitions of metrics.md, through the same function as `vertexflow compare`: rho and
+  // The definitions of docs/metrics.md, through the same function as `vertexflow compare`: rho and
   // the edge-error CV use the input surface's curvature at each vertex's current position.
   Mesh input_mesh, result_mesh;
   input_mesh.V = input;

@@ -12,7 +12,7 @@
 
 namespace vertexflow::cli {
 
-/// Metrics (../docs/metrics.md) of `result` (positions, the input's faces F) against `input`:
+/// Metrics (docs/metrics.md) of `result` (positions, the input's faces F) against `input`:
 /// counts, flipped and degenerate faces, quality of both, displacement in mean input edge
 /// lengths, redistribution rho, edge-error CV and volume change. Throws std::invalid_argument
 /// for a non-manifold mesh (curvature.h).

@@ -178,7 +178,7 @@ def main():
         fig4_images.append((("input" if lam is None else f"lambda {lam}"), image))
     md += ["## Fig. 4: the strength knob lambda", "",
            "Displacement and distances in mean edge lengths of the input; rho = Spearman(surface |k1|+|k2|, "
-           "vertex density); CV = coefficient of variation of the per-edge error (docs: metrics.md).", "",
+           "vertex density); CV = coefficient of variation of the per-edge error (docs/metrics.md).", "",
            table(["mesh", "lambda", "mean displacement", "rho in -> out", "edge-error CV in -> out",
                   "mean distance to input", "Hausdorff to input", "flips", "volume change %"],
                  [[f["mesh"], f["lambda"], fmt(f["displacement"]), f"{fmt(f['rho_input'])} -> {fmt(f['rho'])}",

@@ -1,4 +1,4 @@
-// Every figure of ../docs/metrics.md for one result of the flow, its input and optionally a
+// Every figure of docs/metrics.md for one result of the flow, its input and optionally a
 // dense reference of the same surface (the `vertexflow compare` command).
 //
 // Roles: "input" is the mesh given to the flow (M0), "result" the mesh it returned (M),

@@ -1,4 +1,4 @@
-// Distances between triangle meshes (../docs/metrics.md, "Shape fidelity").
+// Distances between triangle meshes (docs/metrics.md, "Shape fidelity").
 //
 // Distance A -> B: points on A (area-uniform samples, plus every vertex and every edge
 // midpoint of A), each measured to the exact closest point on B's triangles. The closest

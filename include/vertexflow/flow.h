@@ -4,7 +4,7 @@
 //
 // Scale and rigid motion: the flow runs on a copy translated to its centroid and scaled to
 // mean edge length 1, where curvature times edge length is dimensionless and the balance of
-// the terms does not depend on the mesh's size or resolution (method-notes, "Scale"). The
+// the terms does not depend on the mesh's size or resolution (docs/method-notes.md, point 1, "Scale"). The
 // result is mapped back, so flowing a rotated, translated, uniformly scaled mesh gives the
 // same transform of the result.
 //
@@ -67,10 +67,10 @@ struct FlowOptions {
   /// d of Eq. 6 is the principal curvature radius at this percentile of |k| (largest
   /// curvatures). 100 is the paper's literal "minimum radius of all vertices", which a single
   /// noisy vertex of a scan decides; 99 gives the same result on clean meshes and less drift
-  /// on scans (method-notes, point 4).
+  /// on scans (docs/method-notes.md, point 4).
   double d_percentile = 99.0;
   /// Solves, each with curvature recomputed on the previous result. One by default: repeated
-  /// solves kept lowering triangle quality without converging (method-notes, point 5).
+  /// solves kept lowering triangle quality without converging (docs/method-notes.md, point 5).
   int iterations = 1;
   /// After each solve, move every free vertex to the closest point of the input surface near
   /// it (a walk over the input's faces from the vertex's own, so it never jumps through a thin

@@ -20,7 +20,7 @@
 //             r_i = 0 in the paper; by default the normal part of L(p_i) (FairnessTarget)
 //
 // The system minimises F_tan + lambda F_sd + mu F_smo + epsilon lambda 1/|V| sum |v_i - p_i|^2.
-// Two choices the paper leaves open are made here (../docs: method-notes):
+// Two choices the paper leaves open are made here (docs/method-notes.md):
 // - F_em enters through its tangential gradient (Eq. 13-19) with weight 1/|E| on the squared
 //   rows, the same per-element averaging as F_sd's 1/|V|, so the balance of the terms does not
 //   depend on the resolution. (The paper's literal F_em has its minimum at a collapsed mesh.)

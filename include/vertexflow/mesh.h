@@ -46,7 +46,7 @@ struct VertexProperty {
 
 /// Relative area below which a triangle counts as degenerate: area < kDegenerateAreaRelative *
 /// (bounding-box diagonal)^2. The same bound is used when reading (such faces are removed) and
-/// when measuring a result (../docs/metrics: "degenerate faces").
+/// when measuring a result (docs/metrics.md, "degenerate faces").
 inline constexpr double kDegenerateAreaRelative = 1e-12;
 
 /// A triangle mesh with optional per-vertex data.

@@ -1,4 +1,4 @@
-// Measurements of what the flow did (../docs/metrics.md is the contract).
+// Measurements of what the flow did (docs/metrics.md is the contract).
 #pragma once
 
 #include "vertexflow/curvature.h"

@@ -1,4 +1,4 @@
-// Triangle quality (../docs/metrics.md, "Mesh quality").
+// Triangle quality (docs/metrics.md, "Mesh quality").
 //
 // Radius ratio q = 2 r / R (inradius r, circumradius R), in [0, 1]: 1 for an equilateral
 // triangle, 0 for a degenerate one (Pebay and Baker 2003). Computed as

@@ -4,7 +4,7 @@
 //
 // The normal equations of the energy are H d = b for the displacement d = V - P, with
 //   H = G P G + (L^T S L) (x) I_3 + D,     b = -(G P G P + L^T S (L P - R)),
-// where, per vertex i (docs/method-notes.md, "The normal equations"):
+// where, per vertex i (docs/method-notes.md, "The energy, written out"):
 //   K_i = |k_i1| T_i1 T_i1^T + |k_i2| T_i2 T_i2^T                    (Eq. 2-4, as a quadratic form)
 //   G   the 3n x 3n block operator (G x)_i = sum_{j in N(i)} (K_i + K_j)(x_i - x_j)
 //       (the g_i of Eq. 16; symmetric)

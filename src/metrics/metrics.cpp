@@ -68,7 +68,7 @@ EdgeErrorStats edge_error_stats(const Vertices& V, const Topology& topology,
   for (Index e = 0; e < ne; ++e) {
     const Index i = topology.edges(e, 0), j = topology.edges(e, 1);
     const Eigen::Vector3d d = (V.row(j) - V.row(i)).transpose();
-    // Eq. 2-4 (f_em = the mean of both endpoints' quadratic forms), divided by 8 (metrics.md).
+    // Eq. 2-4 (f_em = the mean of both endpoints' quadratic forms), divided by 8 (docs/metrics.md).
     const double f_em = 0.5 * (d.dot(surface_tensors[static_cast<std::size_t>(i)] * d) +
                                d.dot(surface_tensors[static_cast<std::size_t>(j)] * d));
     delta[e] = f_em / 8.0;

@@ -8,7 +8,7 @@
 //
 // BLAS: the supernodal factorisation calls BLAS. Debian's default BLAS is the pthread build of
 // OpenBLAS, whose results depend on its thread count (sums in a different order) and whose
-// threads made the factorisation slower on 2 cores (docs/method-notes.md, solver facts). So
+// threads made the factorisation slower on 2 cores (docs/method-notes.md, "Solver facts"). So
 // every factorisation first sets OpenBLAS (looked up at run time; any other BLAS works too) to
 // one thread: the same bytes for every run. This sets the process-wide OpenBLAS thread count.
 // Under an address-space limit (RLIMIT_AS or RLIMIT_DATA) the simplicial method, which needs
