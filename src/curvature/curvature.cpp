@@ -7,9 +7,12 @@
 // compiler vectorises (AVX2 + FMA where the machine has it); they use a small scalar 3-vector
 // (Vec3), which vectorises across lanes, where Eigen::Vector3d would pack within one vector.
 // One 72-byte record per face is the only scratch memory, and large buffers get huge pages.
+// One file of about 630 lines on purpose: every pass shares that record's layout and the lane
+// helpers (Vec3, the SIMD clones), which would otherwise become an internal header of their own.
 #include "vertexflow/curvature.h"
 
 #include "common/huge_pages.h"
+#include "numerics/parallel.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -30,9 +33,7 @@ using CornerAreas = Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
 template <class Body>
 void parallel_range(Index n, Body&& body) {
-  tbb::parallel_for(tbb::blocked_range<Index>(0, n, 2048), [&](const tbb::blocked_range<Index>& r) {
-    for (Index i = r.begin(); i != r.end(); ++i) body(i);
-  });
+  parallel_for_index(n, body, 2048);
 }
 
 // The passes written as loops over blocks of lanes (the *_block functions) get an AVX2 + FMA

@@ -3,6 +3,8 @@
 // which is all a shaded mesh with a wireframe needs. Multisampling goes through a framebuffer
 // object resolved into OSMesa's buffer. The legend's text is drawn with FreeType; the colour
 // bar itself is a few filled rectangles written straight into the image. PNG via libpng.
+// About 600 lines in one file: the scene, the legend and the output share one OSMesa context and
+// its GL state, whose set-up and tear-down order matters.
 #include "vertexflow/render.h"
 
 #include "vertexflow/colormap.h"
