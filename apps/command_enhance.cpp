@@ -7,6 +7,7 @@
 #include "vertexflow/html_report.h"
 #include "vertexflow/report_json.h"
 #include "vertexflow/timing.h"
+#include "vertexflow/topology.h"
 #include "vertexflow/unsharp.h"
 
 #include <fmt/format.h>
@@ -148,9 +149,9 @@ struct MethodRun {
 
 using Progress = std::function<void(const std::string&)>;
 
-// The flow. Report: options, solver, guard, seconds.
-MethodRun run_flow(const Mesh& mesh, const FlowOptions& options, const Progress& phase) {
-  FlowResult result = vertex_flow(mesh.V, mesh.F, options);
+// The flow, with the caller's topology of mesh.F. Report: options, solver, guard, seconds.
+MethodRun run_flow(const Mesh& mesh, const Topology& topology, const FlowOptions& options, const Progress& phase) {
+  FlowResult result = vertex_flow(mesh.V, mesh.F, topology, options);
   const FlowReport& r = result.report;
   phase(fmt::format(
       "curvature {:.3f} s, assembly {:.3f} s, solve {:.3f} s, projection {:.3f} s, guard {:.3f} s; {} vertices "
@@ -261,9 +262,17 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     else
       phase(fmt::format("flowing {} vertices (lambda {}, mu {})", mesh.num_vertices(), o->flow.weights.lambda,
                         o->flow.weights.mu));
+    // The topology of F, built once: the flow and both reports use it. (unsharp_mask builds its
+    // own, so the baseline builds it only for a report.)
+    Topology topology;
     MethodRun run;
     try {
-      run = unsharp ? run_unsharp(mesh, o->unsharp) : run_flow(mesh, o->flow, phase);
+      if (unsharp) {
+        run = run_unsharp(mesh, o->unsharp);
+      } else {
+        topology = build_topology(mesh.F, mesh.num_vertices());
+        run = run_flow(mesh, topology, o->flow, phase);
+      }
     } catch (const std::invalid_argument& e) {
       throw std::runtime_error(o->input + ": " + e.what());
     }
@@ -280,7 +289,10 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     const double seconds_write = seconds_since(start);
 
     if (!o->report_file.empty() || !o->html_file.empty()) {
-      nlohmann::json report = flow_metrics(mesh.V, out.V, mesh.F);
+      if (unsharp) topology = build_topology(mesh.F, mesh.num_vertices());
+      // Each mesh's curvature, computed once for the metrics and the HTML report.
+      const ReportCurvatures curvatures = report_curvatures(mesh, out, topology);
+      nlohmann::json report = flow_metrics(mesh, out, topology, curvatures);
       report.update(run.report);
       report["seconds"]["read"] = seconds_read;
       report["seconds"]["write"] = seconds_write;
@@ -292,7 +304,8 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
         phase("report written to " + o->report_file);
       }
       if (!o->html_file.empty()) {
-        write_html_report(o->html_file, mesh, out, report.dump(), html_report_options(o->input, o->output));
+        write_html_report(o->html_file, mesh, out, curvatures.input, curvatures.result, report.dump(),
+                          html_report_options(o->input, o->output));
         phase("HTML report written to " + o->html_file);
       }
     }
