@@ -5,7 +5,9 @@
 
 #include "vertexflow/flow.h"
 #include "vertexflow/html_report.h"
+#include "vertexflow/report_json.h"
 #include "vertexflow/timing.h"
+#include "vertexflow/topology.h"
 #include "vertexflow/unsharp.h"
 
 #include <fmt/format.h>
@@ -15,6 +17,7 @@
 #include <chrono>
 #include <cstdint>
 #include <cstring>
+#include <functional>
 #include <sstream>
 #include <utility>
 
@@ -135,17 +138,44 @@ std::vector<Index> read_pins(const std::string& path, Index num_vertices) {
   return pins;
 }
 
-// The unsharp-mask baseline (unsharp.h) in the flow's result type, so that both methods share
-// the report below. Only the fields that mean something for it are set.
-FlowResult unsharp_as_flow_result(const Mesh& mesh, const UnsharpOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  UnsharpResult unsharp = unsharp_mask(mesh.V, mesh.F, options);
-  FlowResult result;
-  result.V = std::move(unsharp.V);
-  result.report.fixed_vertices = unsharp.fixed_vertices;
-  result.report.mean_edge_length = mean_edge_length(mesh.V, build_topology(mesh.F, mesh.num_vertices()));
-  result.report.seconds_solve = seconds_since(start);
-  return result;
+// What a method did, for the report: the new positions and the report's sections that are the
+// method's own (its options, what it reported, the seconds of its phases), each written by its
+// to_json (report_json.h). The command adds the metrics, file names and read and write times,
+// so neither method's report is squeezed into the other's.
+struct MethodRun {
+  Vertices V;
+  nlohmann::json report;
+};
+
+using Progress = std::function<void(const std::string&)>;
+
+// The flow, with the caller's topology of mesh.F. Report: options, solver, guard, seconds.
+MethodRun run_flow(const Mesh& mesh, const Topology& topology, const FlowOptions& options, const Progress& phase) {
+  FlowResult result = vertex_flow(mesh.V, mesh.F, topology, options);
+  const FlowReport& r = result.report;
+  phase(fmt::format(
+      "curvature {:.3f} s, assembly {:.3f} s, solve {:.3f} s, projection {:.3f} s, guard {:.3f} s; {} vertices "
+      "limited by the guard",
+      r.seconds_curvature, r.seconds_assembly, r.seconds_solve, r.seconds_projection, r.seconds_guard,
+      r.limited_vertices));
+  MethodRun run;
+  run.report = r;
+  run.report["options"] = options;
+  run.V = std::move(result.V);
+  return run;
+}
+
+// The unsharp-mask baseline (unsharp.h). Report: options, fixed_vertices, seconds.
+MethodRun run_unsharp(const Mesh& mesh, const UnsharpOptions& options) {
+  const auto start = Clock::now();
+  UnsharpResult result = unsharp_mask(mesh.V, mesh.F, options);
+  const double seconds = seconds_since(start);
+  MethodRun run;
+  run.report = result;
+  run.report["options"] = options;
+  run.report["seconds"] = {{"unsharp", seconds}};
+  run.V = std::move(result.V);
+  return run;
 }
 
 }  // namespace
@@ -230,25 +260,27 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
       phase(fmt::format("unsharp mask on {} vertices (weight {}, {} smoothing iterations)", mesh.num_vertices(),
                         o->unsharp.weight, o->unsharp.smoothing_iterations));
     else
-      phase(fmt::format("flowing {} vertices (lambda {}, mu {})", mesh.num_vertices(), o->flow.weights.lambda, o->flow.weights.mu));
-    FlowResult result;
+      phase(fmt::format("flowing {} vertices (lambda {}, mu {})", mesh.num_vertices(), o->flow.weights.lambda,
+                        o->flow.weights.mu));
+    // The topology of F, built once: the flow and both reports use it. (unsharp_mask builds its
+    // own, so the baseline builds it only for a report.)
+    Topology topology;
+    MethodRun run;
     try {
-      result = unsharp ? unsharp_as_flow_result(mesh, o->unsharp) : vertex_flow(mesh.V, mesh.F, o->flow);
+      if (unsharp) {
+        run = run_unsharp(mesh, o->unsharp);
+      } else {
+        topology = build_topology(mesh.F, mesh.num_vertices());
+        run = run_flow(mesh, topology, o->flow, phase);
+      }
     } catch (const std::invalid_argument& e) {
       throw std::runtime_error(o->input + ": " + e.what());
     }
-    const FlowReport& r = result.report;
-    if (!unsharp)
-      phase(fmt::format(
-          "curvature {:.3f} s, assembly {:.3f} s, solve {:.3f} s, projection {:.3f} s, guard {:.3f} s; {} vertices "
-          "limited by the guard",
-          r.seconds_curvature, r.seconds_assembly, r.seconds_solve, r.seconds_projection, r.seconds_guard,
-          r.limited_vertices));
 
     // Same connectivity and colours; per-vertex properties of the input (say, curvature from an
     // earlier run) no longer describe the moved vertices and are not carried over.
     Mesh out;
-    out.V = result.V;
+    out.V = std::move(run.V);
     out.F = mesh.F;
     out.colors = mesh.colors;
     start = std::chrono::steady_clock::now();
@@ -257,57 +289,23 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     const double seconds_write = seconds_since(start);
 
     if (!o->report_file.empty() || !o->html_file.empty()) {
-      nlohmann::json report = flow_metrics(mesh.V, result.V, mesh.F);
+      if (unsharp) topology = build_topology(mesh.F, mesh.num_vertices());
+      // Each mesh's curvature, computed once for the metrics and the HTML report.
+      const ReportCurvatures curvatures = report_curvatures(mesh, out, topology);
+      nlohmann::json report = flow_metrics(mesh, out, topology, curvatures);
+      report.update(run.report);
+      report["seconds"]["read"] = seconds_read;
+      report["seconds"]["write"] = seconds_write;
+      report["method"] = o->method;
       report["input"] = o->input;
       report["output"] = o->output;
-      report["options"] = {
-          {"lambda", o->flow.weights.lambda},
-          {"mu", o->flow.weights.mu},
-          {"epsilon", o->flow.weights.epsilon},
-          {"d_percentile", o->flow.d_percentile},
-          {"iterations", o->flow.iterations},
-          {"fix_boundary", o->flow.fix_boundary},
-          {"min_quality", o->flow.min_quality},
-          {"pinned", o->flow.pinned.size()},
-          {"project_to_input", o->flow.project_to_input},
-          {"feature_angle", o->flow.feature_angle},
-          {"fairness_target", o->flow.weights.fairness_target == FairnessTarget::Zero ? "zero" : "input-normal"}};
-      report["seconds"] = {{"read", seconds_read},
-                           {"curvature", r.seconds_curvature},
-                           {"assembly", r.seconds_assembly},
-                           {"solve", r.seconds_solve},
-                           {"factorization", r.seconds_factorization},
-                           {"projection", r.seconds_projection},
-                           {"guard", r.seconds_guard},
-                           {"write", seconds_write}};
-      report["solver"] = {{"relative_residual", r.solver_error},
-                          {"d", r.d},
-                          {"mean_edge_length", r.mean_edge_length},
-                          {"method", r.solver_used == LinearSolver::Direct       ? "direct (CHOLMOD)"
-                                     : r.solver_used == LinearSolver::Multilevel ? "conjugate gradients, multilevel"
-                                                                                 : "conjugate gradients"},
-                          {"iterations", r.solver_iterations}};
-      report["guard"] = {{"faces_bad_before_guard", r.flipped_before_guard},
-                         {"faces_low_quality_before_guard", r.low_quality_before_guard},
-                         {"limited_vertices", r.limited_vertices},
-                         {"fixed_vertices", r.fixed_vertices}};
-      report["method"] = o->method;
-      if (unsharp) {  // the flow's options, solver and guard do not apply
-        report["options"] = {{"weight", o->unsharp.weight},
-                             {"smoothing_iterations", o->unsharp.smoothing_iterations},
-                             {"fix_boundary", o->unsharp.fix_boundary},
-                             {"pinned", o->unsharp.pinned.size()}};
-        report["seconds"] = {{"read", seconds_read}, {"unsharp", r.seconds_solve}, {"write", seconds_write}};
-        report.erase("solver");
-        report.erase("guard");
-        report["fixed_vertices"] = r.fixed_vertices;
-      }
       if (!o->report_file.empty()) {
         write_text_file(o->report_file, report.dump(2) + "\n");
         phase("report written to " + o->report_file);
       }
       if (!o->html_file.empty()) {
-        write_html_report(o->html_file, mesh, out, report.dump(), html_report_options(o->input, o->output));
+        write_html_report(o->html_file, mesh, out, curvatures.input, curvatures.result, report.dump(),
+                          html_report_options(o->input, o->output));
         phase("HTML report written to " + o->html_file);
       }
     }

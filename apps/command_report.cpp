@@ -3,7 +3,9 @@
 #include "cli_common.h"
 #include "report_support.h"
 
+#include "vertexflow/compare.h"
 #include "vertexflow/html_report.h"
+#include "vertexflow/topology.h"
 
 #include <fmt/format.h>
 
@@ -45,9 +47,15 @@ void register_report_command(CLI::App& app, const GlobalOptions& global) {
           "{}: not the connectivity of {} ({} vertices, {} faces here, {} vertices, {} faces there): a report compares "
           "a flow result with its own input",
           o->result, o->input, result.num_vertices(), result.num_faces(), input.num_vertices(), input.num_faces()));
+    // The topology of the shared faces and each mesh's curvature, computed once for the
+    // metrics and the HTML report.
     nlohmann::json metrics;
+    ReportCurvatures curvatures;
+    Topology topology;
     try {
-      metrics = flow_metrics(input.V, result.V, input.F);
+      topology = checked_topology(result, MeshRole::Result);
+      curvatures = report_curvatures(input, result, topology);
+      metrics = flow_metrics(input, result, topology, curvatures);
     } catch (const std::invalid_argument& e) {
       throw std::runtime_error(o->input + ": " + e.what());
     }
@@ -58,7 +66,8 @@ void register_report_command(CLI::App& app, const GlobalOptions& global) {
     if (!o->json_file.empty()) write_text_file(o->json_file, metrics.dump(2, ' ', false, replace) + "\n");
     HtmlReportOptions options = html_report_options(o->input, o->result);
     options.max_display_faces = o->max_display_faces;
-    write_html_report(o->html_file, input, result, metrics.dump(-1, ' ', false, replace), options);
+    write_html_report(o->html_file, input, result, curvatures.input, curvatures.result,
+                      metrics.dump(-1, ' ', false, replace), options);
     if (!global.quiet) fmt::print(stderr, "vertexflow: HTML report written to {}\n", o->html_file);
   });
 }

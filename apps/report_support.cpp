@@ -3,7 +3,6 @@
 #include "cli_common.h"
 #include "vertexflow/compare.h"
 #include "vertexflow/curvature.h"
-#include "vertexflow/flow.h"
 #include "vertexflow/metrics.h"
 #include "vertexflow/quality.h"
 #include "vertexflow/topology.h"
@@ -12,22 +11,28 @@
 
 namespace vertexflow::cli {
 
-nlohmann::json flow_metrics(const Vertices& input, const Vertices& result, const Faces& F) {
+ReportCurvatures report_curvatures(const Mesh& input, const Mesh& result, const Topology& topology) {
+  const CurvatureOptions options = CompareOptions{}.curvature;
+  return {principal_curvatures(input.V, input.F, topology, options),
+          principal_curvatures(result.V, result.F, topology, options)};
+}
+
+nlohmann::json flow_metrics(const Mesh& input, const Mesh& result, const Topology& topology,
+                            const ReportCurvatures& curvatures) {
   // The definitions of docs/metrics.md, through the same function as `vertexflow compare`: rho and
   // the edge-error CV use the input surface's curvature at each vertex's current position.
-  Mesh input_mesh, result_mesh;
-  input_mesh.V = input;
-  input_mesh.F = F;
-  result_mesh.V = result;
-  result_mesh.F = F;
-  const MeshComparison c = compare_meshes(result_mesh, input_mesh, nullptr);
+  ComparePrecomputed precomputed;
+  precomputed.result = {&topology, &curvatures.result};
+  precomputed.input = {&topology, &curvatures.input};
+  const MeshComparison c = compare_meshes(result, input, nullptr, CompareOptions{}, precomputed);
   // The flow's own unit (FlowReport::mean_edge_length is the same number).
-  const double edge = mean_edge_length(input, build_topology(F, static_cast<Index>(input.rows())));
+  const double edge = mean_edge_length(input.V, topology);
   const double unit = edge > 0 ? edge : 1.0;
-  const Eigen::VectorXd moved = (result - input).rowwise().norm() / unit;
-  const double volume_before = signed_volume(input, F);
+  const Faces& F = input.F;
+  const Eigen::VectorXd moved = (result.V - input.V).rowwise().norm() / unit;
+  const double volume_before = signed_volume(input.V, F);
   nlohmann::json report;
-  report["vertices"] = input.rows();
+  report["vertices"] = input.V.rows();
   report["faces"] = F.rows();
   report["flipped_faces"] = c.flipped_faces.value_or(0);
   report["degenerate_faces"] = c.degenerate_faces_result;
@@ -49,7 +54,7 @@ nlohmann::json flow_metrics(const Vertices& input, const Vertices& result, const
   report["abs_mean_curvature_p95"] = {{"input", c.abs_mean_curvature_input.p95},
                                       {"result", c.abs_mean_curvature_result.p95}};
   report["volume_change_percent"] =
-      volume_before != 0 ? 100.0 * (signed_volume(result, F) - volume_before) / std::abs(volume_before) : 0.0;
+      volume_before != 0 ? 100.0 * (signed_volume(result.V, F) - volume_before) / std::abs(volume_before) : 0.0;
   return report;
 }
 

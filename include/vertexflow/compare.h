@@ -26,6 +26,7 @@
 #include "vertexflow/mesh.h"
 #include "vertexflow/metrics.h"
 #include "vertexflow/quality.h"
+#include "vertexflow/topology.h"
 
 #include <optional>
 #include <stdexcept>
@@ -125,5 +126,36 @@ struct MeshComparison {
 /// Parallel (TBB); the figures do not depend on the thread count.
 MeshComparison compare_meshes(const Mesh& result, const Mesh& input, const Mesh* reference,
                               const CompareOptions& options = {});
+
+/// What compare_meshes derives from one mesh before measuring it, for a caller that has it
+/// already: `vertexflow enhance` builds the faces' topology for the flow and needs both meshes'
+/// curvature for its HTML report too, so each is computed once per command. Non-owning; a null
+/// member is computed by compare_meshes as without it.
+struct MeshDerivedData {
+  /// build_topology(mesh.F, mesh.num_vertices()); meshes with the same faces may share one.
+  const Topology* topology = nullptr;
+  /// principal_curvatures(mesh.V, mesh.F, topology, options.curvature): the mesh's own
+  /// curvature at its own scale, with the comparison's estimator options. Only its size is
+  /// checked: the curvature of other positions or options gives wrong figures.
+  const Curvature* curvature = nullptr;
+};
+
+/// Precomputed data of the meshes of one comparison (the reference's is ignored without one).
+struct ComparePrecomputed {
+  MeshDerivedData result, input, reference;
+};
+
+/// The same with data the caller has computed already: the same figures, bit for bit. A given
+/// topology is checked as compare_meshes checks its own (CompareError for a mesh without faces
+/// or a non-manifold one); a topology or curvature for another vertex or face count throws
+/// std::invalid_argument.
+MeshComparison compare_meshes(const Mesh& result, const Mesh& input, const Mesh* reference,
+                              const CompareOptions& options, const ComparePrecomputed& precomputed);
+
+/// The topology of `mesh`, built and checked as compare_meshes does: CompareError naming
+/// `role` ("the result mesh has no faces", "the input mesh: the mesh is not manifold (...)")
+/// otherwise. For a caller that builds the topology itself, so that its errors read as the
+/// comparison's.
+Topology checked_topology(const Mesh& mesh, MeshRole role);
 
 }  // namespace vertexflow

@@ -25,6 +25,7 @@
 // mean quality of the faces merged into it. Histograms and metrics describe the full meshes.
 #pragma once
 
+#include "vertexflow/curvature.h"
 #include "vertexflow/mesh.h"
 
 #include <filesystem>
@@ -54,9 +55,24 @@ struct HtmlReportOptions {
 std::string html_report(const Mesh& input, const Mesh& result, std::string_view metrics_json,
                         const HtmlReportOptions& options = {});
 
+/// The same with each mesh's curvature computed by the caller, who needs it too (`vertexflow
+/// enhance` measures both meshes with compare.h): principal_curvatures of the mesh with the
+/// default CurvatureOptions, as the overload above computes it; the page uses its mean
+/// curvature. The same bytes as the overload above. Throws as above (but for a non-manifold
+/// mesh, which has no curvature), and std::invalid_argument for a curvature without one entry
+/// per vertex.
+std::string html_report(const Mesh& input, const Mesh& result, const Curvature& input_curvature,
+                        const Curvature& result_curvature, std::string_view metrics_json,
+                        const HtmlReportOptions& options = {});
+
 /// html_report written to `path` atomically (write_text_file in io.h). Throws as html_report,
 /// and IoError when the file cannot be written.
 void write_html_report(const std::filesystem::path& path, const Mesh& input, const Mesh& result,
+                       std::string_view metrics_json, const HtmlReportOptions& options = {});
+
+/// The same with the meshes' curvature given, as html_report above.
+void write_html_report(const std::filesystem::path& path, const Mesh& input, const Mesh& result,
+                       const Curvature& input_curvature, const Curvature& result_curvature,
                        std::string_view metrics_json, const HtmlReportOptions& options = {});
 
 }  // namespace vertexflow

@@ -15,19 +15,33 @@
 namespace vertexflow {
 namespace {
 
-// The topology of a mesh compare_meshes measures; CompareError naming the mesh if it has no
-// faces, bad indices or is not manifold (the curvature estimator needs a manifold).
-Topology checked_topology(const Mesh& mesh, MeshRole role) {
-  const std::string name = std::string("the ") + to_string(role) + " mesh";
-  if (mesh.num_faces() == 0) throw CompareError(role, name + " has no faces");
-  Topology topology;
-  try {
-    topology = build_topology(mesh.F, mesh.num_vertices());
-  } catch (const std::invalid_argument& e) {
-    throw CompareError(role, name + ": " + e.what());
-  }
-  if (!topology.is_manifold()) throw CompareError(role, name + ": " + describe_non_manifold(topology));
-  return topology;
+std::string mesh_name(MeshRole role) {
+  return std::string("the ") + to_string(role) + " mesh";
+}
+
+// The checks of checked_topology on a topology the caller built: the curvature estimator needs
+// a manifold.
+void check_topology(const Mesh& mesh, MeshRole role, const Topology& topology) {
+  if (topology.num_vertices != mesh.num_vertices() || topology.num_faces != mesh.num_faces())
+    throw std::invalid_argument("compare_meshes: the topology given for " + mesh_name(role) +
+                                " was built for another mesh");
+  if (mesh.num_faces() == 0) throw CompareError(role, mesh_name(role) + " has no faces");
+  if (!topology.is_manifold()) throw CompareError(role, mesh_name(role) + ": " + describe_non_manifold(topology));
+}
+
+// The caller's topology, checked, or a checked one of our own in `own`.
+const Topology& topology_of(const Mesh& mesh, MeshRole role, const MeshDerivedData& given, Topology& own) {
+  if (!given.topology) return own = checked_topology(mesh, role);
+  check_topology(mesh, role, *given.topology);
+  return *given.topology;
+}
+
+void check_curvature(const Mesh& mesh, MeshRole role, const Curvature* curvature) {
+  if (curvature && (curvature->k1.size() != mesh.num_vertices() || curvature->k2.size() != mesh.num_vertices() ||
+                    curvature->T1.rows() != mesh.num_vertices() || curvature->T2.rows() != mesh.num_vertices()))
+    throw std::invalid_argument("compare_meshes: the curvature given for " + mesh_name(role) + " has " +
+                                std::to_string(curvature->k1.size()) + " vertices, the mesh " +
+                                std::to_string(mesh.num_vertices()));
 }
 
 // The surface's own values at its own vertices (no interpolation needed).
@@ -40,6 +54,18 @@ SurfaceCurvatureAtPoints own_curvature(const Curvature& c) {
 }
 
 }  // namespace
+
+Topology checked_topology(const Mesh& mesh, MeshRole role) {
+  if (mesh.num_faces() == 0) throw CompareError(role, mesh_name(role) + " has no faces");
+  Topology topology;
+  try {
+    topology = build_topology(mesh.F, mesh.num_vertices());
+  } catch (const std::invalid_argument& e) {
+    throw CompareError(role, mesh_name(role) + ": " + e.what());
+  }
+  check_topology(mesh, role, topology);
+  return topology;
+}
 
 const char* to_string(MeshRole role) {
   switch (role) {
@@ -89,9 +115,24 @@ SurfaceCurvatureAtPoints surface_curvature_at(const Vertices& P, const DistanceQ
 
 MeshComparison compare_meshes(const Mesh& result, const Mesh& input, const Mesh* reference,
                               const CompareOptions& options) {
-  const Topology result_topology = checked_topology(result, MeshRole::Result);
-  const Topology input_topology = checked_topology(input, MeshRole::Input);
-  const Topology reference_topology = reference ? checked_topology(*reference, MeshRole::Reference) : Topology{};
+  return compare_meshes(result, input, reference, options, ComparePrecomputed{});
+}
+
+MeshComparison compare_meshes(const Mesh& result, const Mesh& input, const Mesh* reference,
+                              const CompareOptions& options, const ComparePrecomputed& precomputed) {
+  Topology own_result_topology, own_input_topology, own_reference_topology;
+  const Topology& result_topology = topology_of(result, MeshRole::Result, precomputed.result, own_result_topology);
+  const Topology& input_topology = topology_of(input, MeshRole::Input, precomputed.input, own_input_topology);
+  const Topology& reference_topology =
+      reference ? topology_of(*reference, MeshRole::Reference, precomputed.reference, own_reference_topology)
+                : own_reference_topology;
+  check_curvature(result, MeshRole::Result, precomputed.result.curvature);
+  check_curvature(input, MeshRole::Input, precomputed.input.curvature);
+  if (reference) check_curvature(*reference, MeshRole::Reference, precomputed.reference.curvature);
+  // The caller's curvature, or our own computed below.
+  const auto curvature_of = [](const MeshDerivedData& given, const Curvature& own) -> const Curvature& {
+    return given.curvature ? *given.curvature : own;
+  };
 
   MeshComparison c;
   c.has_reference = reference != nullptr;
@@ -102,22 +143,32 @@ MeshComparison compare_meshes(const Mesh& result, const Mesh& input, const Mesh*
   // built once; the result's samples serve both the input and the reference.
   std::optional<DistanceQuery> result_query, input_query, reference_query;
   SurfaceSamples result_samples, input_samples, reference_samples;
-  Curvature result_curvature, input_curvature, reference_curvature;
+  Curvature own_result_curvature, own_input_curvature, own_reference_curvature;
   tbb::parallel_invoke(
       [&] { result_query.emplace(result.V, result.F); }, [&] { input_query.emplace(input.V, input.F); },
       [&] { result_samples = sample_surface(result.V, result.F, options.sampling); },
       [&] { input_samples = sample_surface(input.V, input.F, options.sampling); },
-      [&] { result_curvature = principal_curvatures(result.V, result.F, result_topology, options.curvature); },
-      [&] { input_curvature = principal_curvatures(input.V, input.F, input_topology, options.curvature); },
+      [&] {
+        if (!precomputed.result.curvature)
+          own_result_curvature = principal_curvatures(result.V, result.F, result_topology, options.curvature);
+      },
+      [&] {
+        if (!precomputed.input.curvature)
+          own_input_curvature = principal_curvatures(input.V, input.F, input_topology, options.curvature);
+      },
       [&] {
         if (!reference) return;
         tbb::parallel_invoke([&] { reference_query.emplace(reference->V, reference->F); },
                              [&] { reference_samples = sample_surface(reference->V, reference->F, options.sampling); },
                              [&] {
-                               reference_curvature = principal_curvatures(reference->V, reference->F,
-                                                                          reference_topology, options.curvature);
+                               if (!precomputed.reference.curvature)
+                                 own_reference_curvature = principal_curvatures(reference->V, reference->F,
+                                                                                reference_topology, options.curvature);
                              });
       });
+  const Curvature& result_curvature = curvature_of(precomputed.result, own_result_curvature);
+  const Curvature& input_curvature = curvature_of(precomputed.input, own_input_curvature);
+  const Curvature& reference_curvature = curvature_of(precomputed.reference, own_reference_curvature);
 
   // Shape fidelity.
   c.result_input = symmetric_distance(one_sided_distance(result_samples, *input_query),

@@ -270,10 +270,9 @@ std::string fill_template(std::string_view title, std::string_view data, std::st
   return out;
 }
 
-}  // namespace
-
-std::string html_report(const Mesh& input, const Mesh& result, std::string_view metrics_json,
-                        const HtmlReportOptions& options) {
+// The checks both html_report overloads make before anything else, and the metrics parsed.
+Json checked_metrics(const Mesh& input, const Mesh& result, std::string_view metrics_json,
+                     const HtmlReportOptions& options) {
   if (result.V.rows() != input.V.rows() || result.F.rows() != input.F.rows() || result.F != input.F)
     throw std::invalid_argument(
         fmt::format("the result ({} vertices, {} faces) does not have the input's connectivity ({} vertices, {} faces)",
@@ -284,11 +283,13 @@ std::string html_report(const Mesh& input, const Mesh& result, std::string_view 
     metrics = Json::parse(metrics_json, nullptr, /*allow_exceptions=*/false);
     if (!metrics.is_object()) throw std::invalid_argument("the metrics are not a JSON object");
   }
+  return metrics;
+}
 
+// The page, given each mesh's mean curvature H.
+std::string report_page(const Mesh& input, const Mesh& result, const Eigen::VectorXd& H_input,
+                        const Eigen::VectorXd& H_result, Json metrics, const HtmlReportOptions& options) {
   const Faces& F = input.F;
-  const Topology topology = build_topology(F, input.num_vertices());
-  const Eigen::VectorXd H_input = principal_curvatures(input.V, F, topology).mean();
-  const Eigen::VectorXd H_result = principal_curvatures(result.V, F, topology).mean();
   const Eigen::VectorXd q_input = triangle_quality(input.V, F);
   const Eigen::VectorXd q_result = triangle_quality(result.V, F);
   const Eigen::VectorXd moved = (result.V - input.V).rowwise().norm();
@@ -346,9 +347,40 @@ std::string html_report(const Mesh& input, const Mesh& result, std::string_view 
   return fill_template(escape_html(options.title), script_safe_json(data), html_assets::viewer_script());
 }
 
+}  // namespace
+
+std::string html_report(const Mesh& input, const Mesh& result, std::string_view metrics_json,
+                        const HtmlReportOptions& options) {
+  Json metrics = checked_metrics(input, result, metrics_json, options);
+  const Topology topology = build_topology(input.F, input.num_vertices());
+  const Eigen::VectorXd H_input = principal_curvatures(input.V, input.F, topology).mean();
+  const Eigen::VectorXd H_result = principal_curvatures(result.V, input.F, topology).mean();
+  return report_page(input, result, H_input, H_result, std::move(metrics), options);
+}
+
+std::string html_report(const Mesh& input, const Mesh& result, const Curvature& input_curvature,
+                        const Curvature& result_curvature, std::string_view metrics_json,
+                        const HtmlReportOptions& options) {
+  Json metrics = checked_metrics(input, result, metrics_json, options);
+  const auto check = [&](const Curvature& curvature, const char* name) {
+    if (curvature.k1.size() != input.num_vertices() || curvature.k2.size() != input.num_vertices())
+      throw std::invalid_argument(fmt::format("the {} curvature has {} vertices, the mesh {}", name,
+                                              curvature.k1.size(), input.num_vertices()));
+  };
+  check(input_curvature, "input");
+  check(result_curvature, "result");
+  return report_page(input, result, input_curvature.mean(), result_curvature.mean(), std::move(metrics), options);
+}
+
 void write_html_report(const std::filesystem::path& path, const Mesh& input, const Mesh& result,
                        std::string_view metrics_json, const HtmlReportOptions& options) {
   write_text_file(path, html_report(input, result, metrics_json, options));
+}
+
+void write_html_report(const std::filesystem::path& path, const Mesh& input, const Mesh& result,
+                       const Curvature& input_curvature, const Curvature& result_curvature,
+                       std::string_view metrics_json, const HtmlReportOptions& options) {
+  write_text_file(path, html_report(input, result, input_curvature, result_curvature, metrics_json, options));
 }
 
 }  // namespace vertexflow

@@ -184,6 +184,32 @@ TEST(CliEnhance, BadPinFileAndNonManifoldInputFailCleanly) {
 namespace vertexflow {
 namespace {
 
+// Values CLI11's checks let through (NaN passes "> 0" and range checks, as every comparison with
+// it is false) are refused by the library (validate_flow_options, unsharp_mask): one line naming
+// the input, nothing written.
+TEST(CliEnhance, LibraryRefusalsAreOneLineNamingTheInput) {
+  test::ScratchDir dir("cli-enhance-refused");
+  const auto out = dir.file("out.ply"), report = dir.file("r.json");
+  const std::string input = test::data_path("spot.obj").string();
+  const struct {
+    std::string options;
+    std::string problem;
+  } cases[] = {
+      {"--lambda nan", "vertex flow: lambda must be a finite number > 0"},
+      {"--mu nan", "vertex flow: mu must be a finite number >= 0"},
+      {"--min-quality nan", "vertex flow: min_quality must be in [0, 1]"},
+      {"--feature-angle nan", "vertex flow: feature_angle must be >= 0 degrees (180 or more disables creases)"},
+      {"--method unsharp --weight inf", "unsharp mask: the weight must be finite"}};
+  for (const auto& c : cases) {
+    const auto r = run_cli("--quiet enhance " + shell_quote(input) + " " + shell_quote(out.string()) + " " + c.options +
+                           " --report " + shell_quote(report.string()));
+    EXPECT_EQ(r.exit_code, 1) << c.options;
+    EXPECT_EQ(r.err, "vertexflow: error: " + input + ": " + c.problem + "\n") << c.options;
+    EXPECT_FALSE(std::filesystem::exists(out)) << c.options;
+    EXPECT_FALSE(std::filesystem::exists(report)) << c.options;
+  }
+}
+
 TEST(CliEnhance, PinFileMustBeARegularFileOfBoundedSize) {
   test::ScratchDir dir("cli-enhance-pins");
   const auto out = dir.file("out.ply");

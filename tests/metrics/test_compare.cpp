@@ -11,6 +11,7 @@
 #include <tbb/global_control.h>
 
 #include <cmath>
+#include <utility>
 
 namespace vertexflow {
 namespace {
@@ -193,6 +194,112 @@ TEST(CompareMeshes, RejectsNonManifoldAndEmptyMeshesNamingThem) {
   } catch (const CompareError& e) {
     EXPECT_EQ(e.role(), MeshRole::Input);
     EXPECT_STREQ(e.what(), "the input mesh has no faces");
+  }
+}
+
+void expect_same_figures(const MeshComparison& a, const MeshComparison& b) {
+  EXPECT_EQ(a.length_scale, b.length_scale);
+  EXPECT_EQ(a.result_input.a_to_b.mean, b.result_input.a_to_b.mean);
+  EXPECT_EQ(a.result_input.b_to_a.max, b.result_input.b_to_a.max);
+  EXPECT_EQ(a.result_input.hausdorff, b.result_input.hausdorff);
+  ASSERT_EQ(a.result_reference.has_value(), b.result_reference.has_value());
+  if (a.result_reference) {
+    EXPECT_EQ(a.result_reference->a_to_b.rms, b.result_reference->a_to_b.rms);
+  }
+  for (const auto& [x, y] :
+       {std::pair{a.edge_error_input, b.edge_error_input}, std::pair{a.edge_error_result, b.edge_error_result}}) {
+    EXPECT_EQ(x.mean, y.mean);
+    EXPECT_EQ(x.max_over_mean, y.max_over_mean);
+    EXPECT_EQ(x.coefficient_of_variation, y.coefficient_of_variation);
+  }
+  EXPECT_EQ(a.redistribution_rho_input, b.redistribution_rho_input);
+  EXPECT_EQ(a.redistribution_rho_result, b.redistribution_rho_result);
+  for (const auto& [x, y] : {std::pair{a.abs_mean_curvature_input, b.abs_mean_curvature_input},
+                             std::pair{a.abs_mean_curvature_result, b.abs_mean_curvature_result}}) {
+    EXPECT_EQ(x.p5, y.p5);
+    EXPECT_EQ(x.p50, y.p50);
+    EXPECT_EQ(x.p95, y.p95);
+    EXPECT_EQ(x.p99, y.p99);
+  }
+  EXPECT_EQ(a.quality_result.mean, b.quality_result.mean);
+  EXPECT_EQ(a.flipped_faces, b.flipped_faces);
+}
+
+// A torus and a copy moved by a smooth field (same faces), and a finer torus as reference.
+struct TorusCase {
+  Mesh input = test::torus(1.0, 0.4, 40, 20);
+  Mesh result = input;
+  Mesh reference = test::torus(1.0, 0.4, 80, 40);
+  TorusCase() {
+    for (Index v = 0; v < input.num_vertices(); ++v) result.V(v, 2) += 0.03 * std::sin(3 * input.V(v, 0));
+  }
+};
+
+TEST(CompareMeshes, PrecomputedTopologyAndCurvatureGiveTheSameFigures) {
+  const TorusCase t;
+  const CompareOptions options = few_samples(5000);
+  const Topology topology = build_topology(t.input.F, t.input.num_vertices());
+  const Topology reference_topology = build_topology(t.reference.F, t.reference.num_vertices());
+  const Curvature input_curvature = principal_curvatures(t.input.V, t.input.F, topology, options.curvature);
+  const Curvature result_curvature = principal_curvatures(t.result.V, t.result.F, topology, options.curvature);
+  const Curvature reference_curvature =
+      principal_curvatures(t.reference.V, t.reference.F, reference_topology, options.curvature);
+  for (const Mesh* reference : {static_cast<const Mesh*>(nullptr), &t.reference}) {
+    const MeshComparison own = compare_meshes(t.result, t.input, reference, options);
+    ComparePrecomputed all;
+    all.result = {&topology, &result_curvature};
+    all.input = {&topology, &input_curvature};
+    all.reference = {&reference_topology, &reference_curvature};
+    expect_same_figures(compare_meshes(t.result, t.input, reference, options, all), own);
+    ComparePrecomputed topology_only;  // one topology shared by both meshes, curvature computed
+    topology_only.result.topology = topology_only.input.topology = &topology;
+    expect_same_figures(compare_meshes(t.result, t.input, reference, options, topology_only), own);
+  }
+}
+
+TEST(CompareMeshes, UsesThePrecomputedCurvature) {
+  const TorusCase t;
+  const CompareOptions options = few_samples(1000);
+  // The curvature of the input scaled by 2 (half the input's): the figures that use the
+  // input's own curvature follow it, so it was not computed again.
+  const Curvature halved = principal_curvatures(Vertices(2 * t.input.V), t.input.F, options.curvature);
+  ComparePrecomputed given;
+  given.input.curvature = &halved;
+  const MeshComparison own = compare_meshes(t.result, t.input, nullptr, options);
+  const MeshComparison c = compare_meshes(t.result, t.input, nullptr, options, given);
+  EXPECT_NEAR(c.abs_mean_curvature_input.p95, 0.5 * own.abs_mean_curvature_input.p95,
+              1e-9 * own.abs_mean_curvature_input.p95);
+  EXPECT_EQ(c.abs_mean_curvature_result.p95, own.abs_mean_curvature_result.p95);
+}
+
+TEST(CompareMeshes, ChecksWhatIsGiven) {
+  const TorusCase t;
+  const Topology other = build_topology(t.reference.F, t.reference.num_vertices());
+  ComparePrecomputed given;
+  given.input.topology = &other;
+  EXPECT_THROW(compare_meshes(t.result, t.input, nullptr, few_samples(100), given), std::invalid_argument);
+  const Curvature other_curvature = principal_curvatures(t.reference.V, t.reference.F);
+  given = {};
+  given.result.curvature = &other_curvature;
+  EXPECT_THROW(compare_meshes(t.result, t.input, nullptr, few_samples(100), given), std::invalid_argument);
+  // A given non-manifold topology is refused as compare_meshes refuses its own, naming the mesh.
+  const Mesh bowtie = test::bowtie();
+  const Topology bowtie_topology = build_topology(bowtie.F, bowtie.num_vertices());
+  given = {};
+  given.result.topology = &bowtie_topology;
+  try {
+    compare_meshes(bowtie, bowtie, nullptr, few_samples(100), given);
+    ADD_FAILURE() << "no error";
+  } catch (const CompareError& e) {
+    EXPECT_EQ(e.role(), MeshRole::Result);
+    EXPECT_NE(std::string(e.what()).find("the result mesh: the mesh is not manifold"), std::string::npos) << e.what();
+  }
+  try {
+    checked_topology(bowtie, MeshRole::Input);
+    ADD_FAILURE() << "no error";
+  } catch (const CompareError& e) {
+    EXPECT_EQ(e.role(), MeshRole::Input);
+    EXPECT_NE(std::string(e.what()).find("the input mesh: the mesh is not manifold"), std::string::npos) << e.what();
   }
 }
 

@@ -189,6 +189,29 @@ TEST(HtmlReport, SameInputSameBytes) {
   EXPECT_NE(html_report(q.input, q.result, R"({"x": 1.5})"), a);
 }
 
+TEST(HtmlReport, GivenCurvatureIsUsedAndGivesTheSameBytes) {
+  const Pair p = torus_pair();
+  const Curvature input = principal_curvatures(p.input.V, p.input.F);
+  const Curvature result = principal_curvatures(p.result.V, p.result.F);
+  const std::string page = html_report(p.input, p.result, R"({"x": 1.5})");
+  EXPECT_EQ(html_report(p.input, p.result, input, result, R"({"x": 1.5})"), page);
+  // Swapped, the input view shows the result's curvature: the given curvature is what is drawn.
+  const nlohmann::json swapped = page_data(html_report(p.input, p.result, result, input, ""));
+  const nlohmann::json data = page_data(page);
+  EXPECT_NE(swapped["input"]["mean_curvature"], data["input"]["mean_curvature"]);
+  EXPECT_EQ(swapped["input"]["positions"], data["input"]["positions"]);
+  test::ScratchDir dir("html-report-curvature");
+  write_html_report(dir.file("r.html"), p.input, p.result, input, result, R"({"x": 1.5})");
+  EXPECT_EQ(test::read_text(dir.file("r.html")), page);
+  // Curvature of another mesh, and the checks of the other overload.
+  const Mesh other = test::torus(1.0, 0.6, 40, 24);
+  const Curvature other_curvature = principal_curvatures(other.V, other.F);
+  EXPECT_THROW(html_report(p.input, p.result, other_curvature, result, ""), std::invalid_argument);
+  EXPECT_THROW(html_report(p.input, p.result, input, other_curvature, ""), std::invalid_argument);
+  EXPECT_THROW(html_report(p.input, other, input, other_curvature, ""), std::invalid_argument);
+  EXPECT_THROW(html_report(p.input, p.result, input, result, "[1, 2]"), std::invalid_argument);
+}
+
 TEST(HtmlReport, LargeMeshIsDecimatedForDisplayWithANote) {
   const Mesh sphere = test::icosphere(1.0, 5);  // 20480 faces
   Mesh moved = sphere;

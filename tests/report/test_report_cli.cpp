@@ -2,11 +2,18 @@
 // overwritten, one-line errors.
 #include "test_support.h"
 
+#include "vertexflow/flow.h"
+#include "vertexflow/io.h"
+#include "vertexflow/report_json.h"
+#include "vertexflow/unsharp.h"
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <filesystem>
+#include <set>
+#include <string>
 
 namespace vertexflow {
 namespace {
@@ -33,6 +40,92 @@ TEST(CliReport, EnhanceWritesTheHtmlReportWithTheJsonMetrics) {
   EXPECT_EQ(data["labels"]["input"], "fandisk.off");
   EXPECT_EQ(data["labels"]["result"], "out.ply");
   EXPECT_NE(r.err.find("HTML report written to"), std::string::npos) << r.err;
+}
+
+std::set<std::string> keys(const nlohmann::json& j) {
+  std::set<std::string> out;
+  for (const auto& [key, value] : j.items()) out.insert(key);
+  return out;
+}
+
+// The metrics both methods' reports hold (flow_metrics).
+const std::set<std::string> kMetricKeys = {"abs_mean_curvature_p95",
+                                           "degenerate_faces",
+                                           "displacement_edge_lengths",
+                                           "drift_edge_lengths",
+                                           "edge_error_cv",
+                                           "edge_error_max_over_mean",
+                                           "faces",
+                                           "flipped_faces",
+                                           "quality_input",
+                                           "quality_result",
+                                           "redistribution_rho",
+                                           "vertices",
+                                           "volume_change_percent"};
+
+std::set<std::string> with_metrics(std::set<std::string> keys) {
+  keys.insert(kMetricKeys.begin(), kMetricKeys.end());
+  return keys;
+}
+
+// The options section is to_json(FlowOptions) (report_json.h) of the options the command line
+// gave, and the solver and guard sections to_json(FlowReport) of the same flow run here.
+TEST(CliReport, EnhanceReportHoldsTheFlowsOptionsAndReport) {
+  test::ScratchDir dir("cli-report-flow-json");
+  const auto input = test::data_path("fandisk.off");
+  const auto out = dir.file("out.ply"), json = dir.file("r.json");
+  const auto r = run_cli("--quiet enhance " + q(input) + " " + q(out) + " --report " + q(json) +
+                         " --lambda 2 --mu 0.25 --fairness zero --min-quality 0.2 --feature-angle 30 --free-boundary "
+                         "--no-projection");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto report = nlohmann::json::parse(test::read_text(json));
+  FlowOptions options;
+  options.weights.lambda = 2;
+  options.weights.mu = 0.25;
+  options.weights.fairness_target = FairnessTarget::Zero;
+  options.min_quality = 0.2;
+  options.feature_angle = 30;
+  options.fix_boundary = false;
+  options.project_to_input = false;
+  EXPECT_EQ(report["options"], nlohmann::json(options));
+  for (const char* key : {"solver", "solver_tolerance", "max_halvings", "curvature"})
+    EXPECT_TRUE(report["options"].contains(key)) << key;
+  EXPECT_EQ(keys(report), with_metrics({"input", "output", "method", "options", "solver", "guard", "seconds"}));
+  EXPECT_EQ(keys(report["seconds"]), (std::set<std::string>{"read", "curvature", "assembly", "solve", "factorization",
+                                                            "projection", "guard", "write"}));
+  const Mesh mesh = read_mesh(input);
+  const FlowResult flow = vertex_flow(mesh.V, mesh.F, options);
+  const nlohmann::json expected = flow.report;
+  EXPECT_EQ(report["solver"], expected["solver"]);
+  EXPECT_EQ(report["guard"], expected["guard"]);
+  EXPECT_EQ(read_mesh(out).V, flow.V);
+}
+
+// The baseline's report has its own sections, the same keys as before it had a path of its own:
+// its options, its fixed vertices and its phases' seconds; no solver or guard.
+TEST(CliReport, UnsharpReportHoldsItsOwnSections) {
+  test::ScratchDir dir("cli-report-unsharp-json");
+  const auto input = test::data_path("fandisk.off");
+  const auto out = dir.file("out.ply"), json = dir.file("r.json"), html = dir.file("r.html");
+  const auto r = run_cli("--quiet enhance " + q(input) + " " + q(out) +
+                         " --method unsharp --weight 0.5 "
+                         "--smoothing-iterations 3 --free-boundary --report " +
+                         q(json) + " --html " + q(html));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto report = nlohmann::json::parse(test::read_text(json));
+  UnsharpOptions options;
+  options.weight = 0.5;
+  options.smoothing_iterations = 3;
+  options.fix_boundary = false;
+  EXPECT_EQ(report["options"], nlohmann::json(options));
+  EXPECT_EQ(report["method"], "unsharp");
+  EXPECT_EQ(keys(report), with_metrics({"input", "output", "method", "options", "fixed_vertices", "seconds"}));
+  EXPECT_EQ(keys(report["seconds"]), (std::set<std::string>{"read", "unsharp", "write"}));
+  const Mesh mesh = read_mesh(input);
+  const UnsharpResult unsharp = unsharp_mask(mesh.V, mesh.F, options);
+  EXPECT_EQ(report["fixed_vertices"], unsharp.fixed_vertices);
+  EXPECT_EQ(read_mesh(out).V, unsharp.V);
+  EXPECT_FALSE(test::read_text(html).empty());
 }
 
 TEST(CliReport, ReportOfAnExistingResult) {

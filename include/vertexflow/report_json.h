@@ -1,0 +1,62 @@
+// The JSON of the options and reports of the flow and the unsharp-mask baseline: one to_json
+// per type (nlohmann's ADL form, so `nlohmann::json j = options;` works), written once here and
+// used by `vertexflow enhance --report` and the HTML report's metrics table.
+//
+// Conventions
+// - Every field of each struct is written, under its own name, except where stated: a test
+//   (tests/report/test_report_json.cpp) fails when a field is added to a struct and not here.
+// - Enumerations are written as names, never as their integer values.
+// - Vertex lists (pinned vertices) are written as their count; positions are never written
+//   (they go to the mesh file).
+// - For nlohmann::json (ordered or other basic_json types would fall back to nlohmann's
+//   integer conversion of the enumerations).
+#pragma once
+
+#include "vertexflow/curvature.h"
+#include "vertexflow/flow.h"
+#include "vertexflow/flow_energy.h"
+#include "vertexflow/unsharp.h"
+
+#include <nlohmann/json_fwd.hpp>
+
+namespace vertexflow {
+
+/// "zero" or "input-normal" (the spellings of `vertexflow enhance --fairness`).
+void to_json(nlohmann::json& j, FairnessTarget target);
+
+/// "automatic", "direct (CHOLMOD)", "conjugate gradients" (Iterative) or "conjugate gradients,
+/// multilevel" (Multilevel).
+void to_json(nlohmann::json& j, LinearSolver solver);
+
+/// "max1999", "area" or "angle".
+void to_json(nlohmann::json& j, NormalWeighting weighting);
+
+/// {lambda, mu, epsilon, fairness_target}.
+void to_json(nlohmann::json& j, const EnergyWeights& weights);
+
+/// {normal_weighting, smoothing_rounds}.
+void to_json(nlohmann::json& j, const CurvatureOptions& options);
+
+/// One flat object: the weights' keys (to_json of EnergyWeights) beside d_percentile,
+/// iterations, project_to_input, feature_angle, fix_boundary, pinned (the count of pinned
+/// vertices), max_halvings, min_quality, curvature (an object), solver and solver_tolerance.
+/// The weights are not nested so that the report keeps the keys it had before FlowOptions held
+/// them as a struct (options.lambda, options.mu, ...).
+void to_json(nlohmann::json& j, const FlowOptions& options);
+
+/// Three objects, the sections of the enhance report:
+/// - "solver": relative_residual (solver_error), d, mean_edge_length, method (solver_used) and
+///   iterations (solver_iterations);
+/// - "guard": faces_bad_before_guard (flipped_before_guard), faces_low_quality_before_guard,
+///   limited_vertices and fixed_vertices;
+/// - "seconds": curvature, assembly, solve, factorization, projection and guard (the
+///   seconds_* fields).
+void to_json(nlohmann::json& j, const FlowReport& report);
+
+/// {weight, smoothing_iterations, fix_boundary, pinned (the count of pinned vertices)}.
+void to_json(nlohmann::json& j, const UnsharpOptions& options);
+
+/// {fixed_vertices}: what the baseline reports besides its positions V (not written).
+void to_json(nlohmann::json& j, const UnsharpResult& result);
+
+}  // namespace vertexflow

@@ -1,0 +1,102 @@
+#include "vertexflow/report_json.h"
+
+#include <nlohmann/json.hpp>
+
+namespace vertexflow {
+
+void to_json(nlohmann::json& j, FairnessTarget target) {
+  j = target == FairnessTarget::Zero ? "zero" : "input-normal";
+}
+
+void to_json(nlohmann::json& j, LinearSolver solver) {
+  switch (solver) {
+    case LinearSolver::Automatic:
+      j = "automatic";
+      return;
+    case LinearSolver::Direct:
+      j = "direct (CHOLMOD)";
+      return;
+    case LinearSolver::Iterative:
+      j = "conjugate gradients";
+      return;
+    case LinearSolver::Multilevel:
+      j = "conjugate gradients, multilevel";
+      return;
+  }
+  j = "?";
+}
+
+void to_json(nlohmann::json& j, NormalWeighting weighting) {
+  switch (weighting) {
+    case NormalWeighting::Max1999:
+      j = "max1999";
+      return;
+    case NormalWeighting::Area:
+      j = "area";
+      return;
+    case NormalWeighting::Angle:
+      j = "angle";
+      return;
+  }
+  j = "?";
+}
+
+void to_json(nlohmann::json& j, const EnergyWeights& weights) {
+  j = {{"lambda", weights.lambda},
+       {"mu", weights.mu},
+       {"epsilon", weights.epsilon},
+       {"fairness_target", weights.fairness_target}};
+}
+
+void to_json(nlohmann::json& j, const CurvatureOptions& options) {
+  j = {{"normal_weighting", options.normal_weighting}, {"smoothing_rounds", options.smoothing_rounds}};
+}
+
+void to_json(nlohmann::json& j, const FlowOptions& options) {
+  j = options.weights;
+  j.update({{"d_percentile", options.d_percentile},
+            {"iterations", options.iterations},
+            {"project_to_input", options.project_to_input},
+            {"feature_angle", options.feature_angle},
+            {"fix_boundary", options.fix_boundary},
+            {"pinned", options.pinned.size()},
+            {"max_halvings", options.max_halvings},
+            {"min_quality", options.min_quality},
+            {"curvature", options.curvature},
+            {"solver", options.solver},
+            {"solver_tolerance", options.solver_tolerance}});
+}
+
+void to_json(nlohmann::json& j, const FlowReport& report) {
+  j = {{"solver",
+        {{"relative_residual", report.solver_error},
+         {"d", report.d},
+         {"mean_edge_length", report.mean_edge_length},
+         {"method", report.solver_used},
+         {"iterations", report.solver_iterations}}},
+       {"guard",
+        {{"faces_bad_before_guard", report.flipped_before_guard},
+         {"faces_low_quality_before_guard", report.low_quality_before_guard},
+         {"limited_vertices", report.limited_vertices},
+         {"fixed_vertices", report.fixed_vertices}}},
+       {"seconds",
+        {{"curvature", report.seconds_curvature},
+         {"assembly", report.seconds_assembly},
+         {"solve", report.seconds_solve},
+         {"factorization", report.seconds_factorization},
+         {"projection", report.seconds_projection},
+         {"guard", report.seconds_guard}}}};
+}
+
+void to_json(nlohmann::json& j, const UnsharpOptions& options) {
+  j = {{"weight", options.weight},
+       {"smoothing_iterations", options.smoothing_iterations},
+       {"fix_boundary", options.fix_boundary},
+       {"pinned", options.pinned.size()}};
+}
+
+void to_json(nlohmann::json& j, const UnsharpResult& result) {
+  j = {{"fixed_vertices", result.fixed_vertices}};
+}
+
+}  // namespace vertexflow

@@ -1,0 +1,159 @@
+// report_json.h: every field of every struct is in its JSON, under its name, with its value.
+//
+// Each test binds every field of its struct by name (a structured binding needs exactly as
+// many names as the struct has fields), so adding a field stops this file from compiling until
+// the field is named here, given a non-default value and expected in the JSON.
+#include "vertexflow/report_json.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <set>
+#include <string>
+
+namespace vertexflow {
+namespace {
+
+std::set<std::string> keys(const nlohmann::json& j) {
+  std::set<std::string> out;
+  for (const auto& [key, value] : j.items()) out.insert(key);
+  return out;
+}
+
+// Every key of `changed` has a value other than in `defaults`: each key follows its field.
+void expect_every_value_differs(const nlohmann::json& changed, const nlohmann::json& defaults) {
+  ASSERT_EQ(keys(changed), keys(defaults));
+  for (const auto& [key, value] : changed.items()) EXPECT_NE(value, defaults[key]) << key;
+}
+
+TEST(ReportJson, EnumerationsAreNames) {
+  EXPECT_EQ(nlohmann::json(FairnessTarget::Zero), "zero");
+  EXPECT_EQ(nlohmann::json(FairnessTarget::InputNormal), "input-normal");
+  EXPECT_EQ(nlohmann::json(LinearSolver::Automatic), "automatic");
+  EXPECT_EQ(nlohmann::json(LinearSolver::Direct), "direct (CHOLMOD)");
+  EXPECT_EQ(nlohmann::json(LinearSolver::Iterative), "conjugate gradients");
+  EXPECT_EQ(nlohmann::json(LinearSolver::Multilevel), "conjugate gradients, multilevel");
+  EXPECT_EQ(nlohmann::json(NormalWeighting::Max1999), "max1999");
+  EXPECT_EQ(nlohmann::json(NormalWeighting::Area), "area");
+  EXPECT_EQ(nlohmann::json(NormalWeighting::Angle), "angle");
+}
+
+TEST(ReportJson, EnergyWeightsEveryField) {
+  EnergyWeights weights;
+  auto& [lambda, mu, epsilon, fairness_target] = weights;
+  lambda = 0.25;
+  mu = 0.75;
+  epsilon = 1e-4;
+  fairness_target = FairnessTarget::Zero;
+  const nlohmann::json j = weights;
+  EXPECT_EQ(j, nlohmann::json::parse(R"({"lambda": 0.25, "mu": 0.75, "epsilon": 1e-4, "fairness_target": "zero"})"));
+  expect_every_value_differs(j, EnergyWeights{});
+}
+
+TEST(ReportJson, CurvatureOptionsEveryField) {
+  CurvatureOptions options;
+  auto& [normal_weighting, smoothing_rounds] = options;
+  normal_weighting = NormalWeighting::Angle;
+  smoothing_rounds = 2;
+  const nlohmann::json j = options;
+  EXPECT_EQ(j, nlohmann::json::parse(R"({"normal_weighting": "angle", "smoothing_rounds": 2})"));
+  expect_every_value_differs(j, CurvatureOptions{});
+}
+
+TEST(ReportJson, FlowOptionsEveryField) {
+  FlowOptions options;
+  auto& [weights, d_percentile, iterations, project_to_input, feature_angle, fix_boundary, pinned, max_halvings,
+         min_quality, curvature, solver, solver_tolerance] = options;
+  weights.lambda = 0.25;
+  weights.mu = 0.75;
+  weights.epsilon = 1e-4;
+  weights.fairness_target = FairnessTarget::Zero;
+  d_percentile = 95;
+  iterations = 3;
+  project_to_input = false;
+  feature_angle = 30;
+  fix_boundary = false;
+  pinned = {4, 8, 15};
+  max_halvings = 12;
+  min_quality = 0.2;
+  curvature.normal_weighting = NormalWeighting::Area;
+  curvature.smoothing_rounds = 1;
+  solver = LinearSolver::Multilevel;
+  solver_tolerance = 1e-9;
+  const nlohmann::json j = options;
+  // The weights' keys stay at the top level, where the report has always had them.
+  EXPECT_EQ(j, nlohmann::json::parse(R"({
+    "lambda": 0.25, "mu": 0.75, "epsilon": 1e-4, "fairness_target": "zero",
+    "d_percentile": 95.0, "iterations": 3, "project_to_input": false, "feature_angle": 30.0,
+    "fix_boundary": false, "pinned": 3, "max_halvings": 12, "min_quality": 0.2,
+    "curvature": {"normal_weighting": "area", "smoothing_rounds": 1},
+    "solver": "conjugate gradients, multilevel", "solver_tolerance": 1e-9})"));
+  expect_every_value_differs(j, FlowOptions{});
+  for (const auto& [key, value] : j["curvature"].items()) EXPECT_NE(value, nlohmann::json(CurvatureOptions{})[key]);
+}
+
+TEST(ReportJson, FlowReportEveryFieldInItsSection) {
+  FlowReport report;
+  auto& [mean_edge_length, d, solver_error, flipped_before_guard, low_quality_before_guard, limited_vertices,
+         fixed_vertices, seconds_curvature, seconds_assembly, seconds_solve, seconds_projection, seconds_guard,
+         seconds_factorization, solver_used, solver_iterations] = report;
+  mean_edge_length = 0.5;
+  d = 2.5;
+  solver_error = 1e-8;
+  flipped_before_guard = 1;
+  low_quality_before_guard = 2;
+  limited_vertices = 3;
+  fixed_vertices = 4;
+  seconds_curvature = 0.125;
+  seconds_assembly = 0.25;
+  seconds_solve = 0.375;
+  seconds_projection = 0.5;
+  seconds_guard = 0.625;
+  seconds_factorization = 0.75;
+  solver_used = LinearSolver::Direct;
+  solver_iterations = 42;
+  const nlohmann::json j = report;
+  const nlohmann::json expected = {{"solver",
+                                    {{"relative_residual", 1e-8},
+                                     {"d", 2.5},
+                                     {"mean_edge_length", 0.5},
+                                     {"method", "direct (CHOLMOD)"},
+                                     {"iterations", 42}}},
+                                   {"guard",
+                                    {{"faces_bad_before_guard", 1},
+                                     {"faces_low_quality_before_guard", 2},
+                                     {"limited_vertices", 3},
+                                     {"fixed_vertices", 4}}},
+                                   {"seconds",
+                                    {{"curvature", 0.125},
+                                     {"assembly", 0.25},
+                                     {"solve", 0.375},
+                                     {"projection", 0.5},
+                                     {"guard", 0.625},
+                                     {"factorization", 0.75}}}};
+  EXPECT_EQ(j, expected);
+  const nlohmann::json defaults = FlowReport{};
+  for (const char* section : {"solver", "guard", "seconds"}) expect_every_value_differs(j[section], defaults[section]);
+}
+
+TEST(ReportJson, UnsharpOptionsAndResultEveryField) {
+  UnsharpOptions options;
+  auto& [weight, smoothing_iterations, fix_boundary, pinned] = options;
+  weight = 0.5;
+  smoothing_iterations = 7;
+  fix_boundary = false;
+  pinned = {1, 2};
+  const nlohmann::json j = options;
+  EXPECT_EQ(j,
+            nlohmann::json::parse(R"({"weight": 0.5, "smoothing_iterations": 7, "fix_boundary": false, "pinned": 2})"));
+  expect_every_value_differs(j, UnsharpOptions{});
+
+  UnsharpResult result;
+  auto& [V, fixed_vertices] = result;
+  V = Vertices::Ones(3, 3);  // positions are for the mesh file, not the report
+  fixed_vertices = 9;
+  EXPECT_EQ(nlohmann::json(result), nlohmann::json::parse(R"({"fixed_vertices": 9})"));
+}
+
+}  // namespace
+}  // namespace vertexflow
