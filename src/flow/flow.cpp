@@ -40,7 +40,7 @@ void validate_flow_options(const FlowOptions& o, Index num_vertices) {
 }
 
 FlowResult vertex_flow(const Vertices& V, const Faces& F, const FlowOptions& options) {
-  validate_flow_options(options, static_cast<Index>(V.rows()));
+  // Options are validated by the overload below; the topology needs a non-empty mesh first.
   if (V.rows() == 0 || F.rows() == 0) throw std::invalid_argument("vertex flow: the mesh is empty");
   return vertex_flow(V, F, build_topology(F, static_cast<Index>(V.rows())), options);
 }

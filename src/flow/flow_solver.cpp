@@ -117,7 +117,7 @@ Index largest_flat_region(const FlowTerms& t) {
 std::unique_ptr<CoarseSpaceCorrection> make_multilevel(const FlowTerms& terms) {
   try {
     auto space = std::make_shared<const AggregationCoarseSpace>(terms.ring_start, terms.ring, terms.fixed);
-    return std::make_unique<CoarseSpaceCorrection>(space, galerkin_upper(terms, *space), terms.n);
+    return std::make_unique<CoarseSpaceCorrection>(space, galerkin_upper(terms, *space));
   } catch (const std::runtime_error&) {
     return nullptr;
   }

@@ -73,17 +73,15 @@ void AggregationCoarseSpace::restrict_to(const BlockVector& r, BlockVector& coar
 }
 
 CoarseSpaceCorrection::CoarseSpaceCorrection(std::shared_ptr<const AggregationCoarseSpace> space,
-                                             const BlockSparseMatrix& galerkin_upper, Index num_vertices)
-    : space_(std::move(space)),
-      n_(num_vertices),
-      coarse_(std::make_unique<AdditiveMultilevel>(symmetric_from_upper(galerkin_upper))) {
+                                             const BlockSparseMatrix& galerkin_upper)
+    : space_(std::move(space)), coarse_(std::make_unique<AdditiveMultilevel>(symmetric_from_upper(galerkin_upper))) {
   restricted_.resize(3 * space_->size());
 }
 
 double CoarseSpaceCorrection::add_to(const BlockVector& r, BlockVector& z) {
   space_->restrict_to(r, restricted_);
   coarse_->apply(restricted_, coarse_solution_);
-  return sum_over_vertices(n_, 0.0, [&](Index i) {
+  return sum_over_vertices(space_->num_vertices(), 0.0, [&](Index i) {
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     for (const AggregationCoarseSpace::Weight& w : space_->basis(i))
       sum += w.value * block_at(coarse_solution_, w.aggregate);

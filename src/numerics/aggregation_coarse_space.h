@@ -37,6 +37,7 @@ class AggregationCoarseSpace {
                          const std::vector<char>& fixed);
 
   [[nodiscard]] int size() const { return count_; }
+  [[nodiscard]] Index num_vertices() const { return n_; }
   /// The basis functions non-zero at vertex i, sorted by aggregate: phi_a = (I - omega (I - W))
   /// chi_a on free vertices, W the one-ring average, chi_a the indicator of aggregate a.
   [[nodiscard]] std::span<const Weight> basis(Index i) const {
@@ -59,13 +60,11 @@ class CoarseSpaceCorrection : public PreconditionerCorrection {
  public:
   /// `galerkin_upper`: the upper half (diagonal included) of Phi^T H Phi. Throws
   /// std::runtime_error if its coarsest level is not numerically positive definite.
-  CoarseSpaceCorrection(std::shared_ptr<const AggregationCoarseSpace> space, const BlockSparseMatrix& galerkin_upper,
-                        Index num_vertices);
+  CoarseSpaceCorrection(std::shared_ptr<const AggregationCoarseSpace> space, const BlockSparseMatrix& galerkin_upper);
   double add_to(const BlockVector& r, BlockVector& z) override;
 
  private:
   std::shared_ptr<const AggregationCoarseSpace> space_;
-  Index n_;
   std::unique_ptr<AdditiveMultilevel> coarse_;
   BlockVector restricted_, coarse_solution_;
 };

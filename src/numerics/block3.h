@@ -3,6 +3,7 @@
 // of the flow's normal equations and of the multilevel preconditioner.
 #pragma once
 
+#include "numerics/parallel.h"
 #include "vertexflow/mesh.h"
 
 #include <Eigen/Core>
@@ -45,6 +46,10 @@ struct Sym3 {
 
 /// a . b, summed in chunks of 8192 entries in order (deterministic_sum), so that its rounding
 /// does not depend on the threads.
-double deterministic_dot(const BlockVector& a, const BlockVector& b);
+inline double deterministic_dot(const BlockVector& a, const BlockVector& b) {
+  return deterministic_sum(a.size(), 8192, 0.0, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
+    return a.segment(begin, end - begin).dot(b.segment(begin, end - begin));
+  });
+}
 
 }  // namespace vertexflow

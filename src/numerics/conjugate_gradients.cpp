@@ -9,12 +9,6 @@
 
 namespace vertexflow {
 
-double deterministic_dot(const BlockVector& a, const BlockVector& b) {
-  return deterministic_sum(a.size(), 8192, 0.0, [&](std::ptrdiff_t begin, std::ptrdiff_t end) {
-    return a.segment(begin, end - begin).dot(b.segment(begin, end - begin));
-  });
-}
-
 ConjugateGradients::ConjugateGradients(BlockOperator& op, std::vector<Sym3> block_inverse, const BlockVector& b,
                                        PreconditionerCorrection* correction)
     : op_(op),
