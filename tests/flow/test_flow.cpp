@@ -5,13 +5,19 @@
 
 #include "vertexflow/compare.h"
 #include "vertexflow/distance.h"
+#include "vertexflow/features.h"
 #include "vertexflow/flow.h"
 #include "vertexflow/io.h"
 #include "vertexflow/quality.h"
 
+#include "guard.h"
+#include "surface_projection.h"
+
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdlib>
 #include <functional>
 #include <future>
@@ -25,56 +31,155 @@ double mean_displacement(const Vertices& a, const Vertices& b) {
   return (a - b).rowwise().norm().mean();
 }
 
-// The guarantees of issue 4 on any mesh: no flipped or degenerate faces, boundary fixed,
-// volume kept (closed meshes of data/; not required of the hard cases), triangle quality 2r/R >= 0.25 wherever the
-// input's is >= 0.5, and fewer than 0.1% of faces below 0.3 (or no more than the input had, where it already had more).
-void expect_flow_guarantees(const Mesh& mesh, const FlowResult& result, bool check_volume = true) {
+// What one flow at the given options must do to one mesh, beyond the guarantees that hold for
+// every mesh. Bounds are set from the values measured at the defaults (noted with each case) with
+// a margin of 2-3x, so that a flow that moves nothing, moves too far or leaves the surface fails.
+struct FlowExpectation {
+  const char* file;
+  /// Mean displacement in input mean edge lengths is at least this; 0 where nothing may move
+  /// (every vertex a corner, or a mesh whose vertices are all alike), which is then asserted.
+  double min_displacement;
+  /// Mean one-sided distance from the result's surface to the input's, in mean edge lengths.
+  double max_drift;
+  /// |volume after - volume before| / |volume before| (closed meshes only).
+  double max_volume_change;
+  /// Vertex redistribution rho (docs/metrics.md) after minus before is at least this.
+  double min_rho_gain;
+  /// Fraction of the vertices whose displacement the guard shortened.
+  double max_limited_fraction;
+};
+
+std::ostream& operator<<(std::ostream& out, const FlowExpectation& e) {
+  return out << e.file;
+}
+
+// The guarantees of flow.h on any mesh, at any options: no flipped or degenerate face, fixed
+// vertices bit for bit where they were, every face's radius ratio at or above min(min_quality,
+// its input ratio) (exactly: up to the rounding of mapping the normalised result back).
+void expect_promises_kept(const Mesh& mesh, const FlowResult& result, const FlowOptions& options = {}) {
+  ASSERT_TRUE(result.V.allFinite());
   EXPECT_TRUE(flipped_faces(mesh.V, result.V, mesh.F).empty());
   EXPECT_TRUE(degenerate_faces(result.V, mesh.F).empty());
-  EXPECT_TRUE(result.V.allFinite());
-  // The flow moved something, but not far: displacement in mean edge lengths.
-  const double moved = mean_displacement(result.V, mesh.V) / result.report.mean_edge_length;
-  EXPECT_LT(moved, 1.0);
   const Topology topology = build_topology(mesh.F, mesh.num_vertices());
   for (Index v = 0; v < mesh.num_vertices(); ++v) {
-    if (topology.is_boundary_vertex[static_cast<std::size_t>(v)]) {
+    if (options.fix_boundary && topology.is_boundary_vertex[static_cast<std::size_t>(v)]) {
       ASSERT_EQ(result.V.row(v), mesh.V.row(v)) << v;
     }
   }
-  // Drift (issue 4): mean distance from the result's surface to the input's <= 0.05 mean edge
-  // lengths (area samples, exact distances: distance.h).
+  for (const Index v : options.pinned) ASSERT_EQ(result.V.row(v), mesh.V.row(v)) << v;
+  const Eigen::VectorXd q_in = triangle_quality(mesh.V, mesh.F), q_out = triangle_quality(result.V, mesh.F);
+  for (Index f = 0; f < mesh.num_faces(); ++f) {
+    ASSERT_GE(q_out[f], std::min(options.min_quality, q_in[f]) - 1e-12)
+        << "face " << f << " (input quality " << q_in[f] << ")";
+  }
+}
+
+// The promises, then the effect one flow at `options` must have on `mesh` (expectation).
+void expect_flow_effect(const Mesh& mesh, const FlowResult& result, const FlowExpectation& expected,
+                        const FlowOptions& options = {}) {
+  expect_promises_kept(mesh, result, options);
+  const double edge = result.report.mean_edge_length;
+  const double moved = mean_displacement(result.V, mesh.V) / edge;
+  const double limited = static_cast<double>(result.report.limited_vertices) / static_cast<double>(mesh.num_vertices());
+  // Drift: area samples, exact distances (distance.h).
   SamplingOptions sampling;
   sampling.samples = 50000;
-  const double drift = one_sided_distance(result.V, mesh.F, mesh.V, mesh.F, sampling).mean;
-  EXPECT_LE(drift, 0.05 * result.report.mean_edge_length);
-  if (check_volume && topology.is_closed()) {
-    const double before = signed_volume(mesh.V, mesh.F), after = signed_volume(result.V, mesh.F);
-    EXPECT_LT(std::abs(after - before), 0.005 * std::abs(before));
+  const double drift = one_sided_distance(result.V, mesh.F, mesh.V, mesh.F, sampling).mean / edge;
+  CompareOptions compare;
+  compare.sampling.samples = 1000;  // only rho is used
+  Mesh out = mesh;
+  out.V = result.V;
+  const MeshComparison c = compare_meshes(out, mesh, nullptr, compare);
+  const double rho_gain = c.redistribution_rho_result - c.redistribution_rho_input;
+  const Topology topology = build_topology(mesh.F, mesh.num_vertices());
+  const double volume_change =
+      topology.is_closed() ? std::abs(signed_volume(result.V, mesh.F) / signed_volume(mesh.V, mesh.F) - 1.0) : 0.0;
+  std::cout << "[measured] " << expected.file << ": displacement " << moved << ", drift " << drift << ", volume "
+            << volume_change << ", rho " << c.redistribution_rho_input << " -> " << c.redistribution_rho_result
+            << ", limited " << limited << ", flipped before guard " << result.report.flipped_before_guard
+            << ", low quality before guard " << result.report.low_quality_before_guard << "\n";
+  if (expected.min_displacement > 0) {
+    EXPECT_GE(moved, expected.min_displacement);
+  } else {
+    EXPECT_LE((result.V - mesh.V).cwiseAbs().maxCoeff(), 1e-9 * edge) << "nothing may move";
   }
-  const Eigen::VectorXd q_in = triangle_quality(mesh.V, mesh.F), q_out = triangle_quality(result.V, mesh.F);
-  Index below_in = 0, below_out = 0;
-  for (Index f = 0; f < mesh.num_faces(); ++f) {
-    if (q_in[f] >= 0.5) {
-      ASSERT_GE(q_out[f], 0.25) << "face " << f;
-    }
-    below_in += q_in[f] < 0.3 ? 1 : 0;
-    below_out += q_out[f] < 0.3 ? 1 : 0;
-  }
-  EXPECT_LE(below_out, std::max<Index>(below_in, static_cast<Index>(0.001 * static_cast<double>(mesh.num_faces()))));
+  EXPECT_LE(drift, expected.max_drift);
+  EXPECT_LE(volume_change, expected.max_volume_change);
+  EXPECT_GE(rho_gain, expected.min_rho_gain) << c.redistribution_rho_input << " -> " << c.redistribution_rho_result;
+  EXPECT_LE(limited, expected.max_limited_fraction);
 }
 
-class FlowOnMesh : public ::testing::TestWithParam<const char*> {};
+class FlowOnMesh : public ::testing::TestWithParam<FlowExpectation> {};
 
-TEST_P(FlowOnMesh, KeepsTheGuarantees) {
-  const Mesh mesh = read_mesh(test::data_path(GetParam()));
-  expect_flow_guarantees(mesh, vertex_flow(mesh.V, mesh.F));
+TEST_P(FlowOnMesh, KeepsItsPromisesAndMovesTheVertices) {
+  const Mesh mesh = read_mesh(test::data_path(GetParam().file));
+  expect_flow_effect(mesh, vertex_flow(mesh.V, mesh.F), GetParam());
 }
 
+// Measured at the defaults (displacement, drift, volume change, rho gain, limited fraction) in the
+// comment of each row; the bounds are 2.5x those (limited: 2x; a gain below 0.02 may fall by
+// 1.5x its size or 0.006). rho falls a little on meshes already graded by curvature (QEM
+// decimations, adaptive remeshes: the paper's energy evens their edge errors but cannot add
+// grading, docs/redistribution.md) and is noise on surfaces of constant curvature.
 INSTANTIATE_TEST_SUITE_P(Data, FlowOnMesh,
-                         ::testing::Values("bunny_uniform.off", "fandisk.off", "max-planck-5k.obj", "hemisphere.off",
-                                           "camelhead.off", "spot.obj", "torus.obj", "fertility.off", "rocker-arm.obj",
-                                           "bunny_adaptive.off", "amo_adaptive.off", "sphere_low.off", "suzanne.obj",
-                                           "fandisk_quads.off", "chamfer-cube.off", "icosahedron_binary.stl"),
+                         ::testing::Values(
+                             // 0.14, 0.0097, 0.00021, +0.355, 0; near-uniform scan
+                             FlowExpectation{"bunny_uniform.off", 0.056, 0.024, 0.00053, 0.14, 0.002},
+                             // 0.46, 0.0015, 0.00013, +0.472, 0.213; near-uniform CAD part
+                             FlowExpectation{"fandisk.off", 0.18, 0.0038, 0.00033, 0.19, 0.43},
+                             // 0.262, 0.013, 0.0014, -0.0013, 0.121; QEM-graded
+                             FlowExpectation{"max-planck-5k.obj", 0.1, 0.033, 0.0036, -0.0073, 0.24},
+                             // 0.0288, 0.00057, open, -0.0341, 0; constant curvature
+                             FlowExpectation{"hemisphere.off", 0.012, 0.0014, 0, -0.085, 0.002},
+                             // 0.219, 0.0045, open, +0.04, 0.271
+                             FlowExpectation{"camelhead.off", 0.088, 0.011, 0, 0.016, 0.54},
+                             // 0.262, 0.015, 0.0033, +0.113, 0.0956
+                             FlowExpectation{"spot.obj", 0.1, 0.037, 0.0083, 0.045, 0.19},
+                             // 0.00364, 0.00012, 5.5e-05, +0.0036, 0; graded along the tube
+                             FlowExpectation{"torus.obj", 0.0015, 0.0003, 0.00014, -0.0024, 0.002},
+                             // 0.248, 0.012, 0.0034, -0.0077, 0.0859; graded
+                             FlowExpectation{"fertility.off", 0.099, 0.03, 0.0086, -0.019, 0.17},
+                             // 0.296, 0.018, 0.0018, -0.0029, 0.0398; graded
+                             FlowExpectation{"rocker-arm.obj", 0.12, 0.044, 0.0044, -0.0089, 0.08},
+                             // 0.204, 0.012, 0.00031, +0.05, 0.00986
+                             FlowExpectation{"bunny_adaptive.off", 0.082, 0.03, 0.00077, 0.02, 0.02},
+                             // 0.194, 0.009, 0.00043, +0.007, 0.0343
+                             FlowExpectation{"amo_adaptive.off", 0.077, 0.023, 0.0011, -0.0035, 0.069},
+                             // 0.0291, 0.0015, 0.00046, +0.0119, 0; constant curvature
+                             FlowExpectation{"sphere_low.off", 0.012, 0.0036, 0.0011, -0.006, 0.002},
+                             // 0.132, 0.033, open, +0.031, 0.134
+                             FlowExpectation{"suzanne.obj", 0.053, 0.082, 0, 0.012, 0.27},
+                             // 0.373, 0.0062, 0.0014, +0.292, 0.0157
+                             FlowExpectation{"fandisk_quads.off", 0.15, 0.015, 0.0035, 0.12, 0.031},
+                             // Every vertex a corner of its chamfers; all twelve vertices alike: nothing may move.
+                             FlowExpectation{"chamfer-cube.off", 0, 1e-12, 1e-12, 0, 0},
+                             FlowExpectation{"icosahedron_binary.stl", 0, 1e-12, 1e-12, 0, 0}),
+                         [](const auto& param_info) { return test::test_name(param_info.param.file); });
+
+// The quality promise exactly as flow.h states it, on every bundled mesh, at the default floor
+// and at a higher one.
+class FlowQualityPromise : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(FlowQualityPromise, EveryFaceEndsAtOrAboveItsFloor) {
+  const Mesh mesh = read_mesh(test::data_path(GetParam()));
+  for (const double min_quality : {0.3, 0.5}) {
+    SCOPED_TRACE(min_quality);
+    FlowOptions options;
+    options.min_quality = min_quality;
+    const FlowResult result = vertex_flow(mesh.V, mesh.F, options);
+    std::cout << "[measured] " << GetParam() << " min_quality " << min_quality << ": low quality before guard "
+              << result.report.low_quality_before_guard << ", limited " << result.report.limited_vertices << "\n";
+    expect_promises_kept(mesh, result, options);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Data, FlowQualityPromise,
+                         ::testing::Values("amo.off", "amo_adaptive.off", "armadillo-43k.obj", "bunny.off",
+                                           "bunny_adaptive.off", "bunny_uniform.off", "camelhead.off",
+                                           "chamfer-cube.off", "fandisk.off", "fandisk_quads.off", "fertility.off",
+                                           "hemisphere.off", "horse-48k.ply", "icosahedron_ascii.stl",
+                                           "icosahedron_binary.stl", "max-planck-5k.obj", "rocker-arm.obj",
+                                           "sphere.off", "sphere_low.off", "spot.obj", "suzanne.obj", "torus.obj"),
                          [](const auto& param_info) { return test::test_name(param_info.param); });
 
 // Issue 4's redistribution and edge-error bars at the default options, measured as the report
@@ -108,15 +213,39 @@ INSTANTIATE_TEST_SUITE_P(Data, FlowRedistribution,
                                            RedistributionCase{"max-planck-5k.obj", -0.01}),
                          [](const auto& param_info) { return test::test_name(param_info.param.file); });
 
-// Hard cases (issue 4): an unguarded solve flips faces on each; the guarded flow must not.
+// Hard cases (issue 4): an unguarded solve flips faces on each; the guard repairs them without
+// freezing the mesh.
+void expect_guard_had_work(const FlowResult& result) {
+  EXPECT_GT(result.report.flipped_before_guard, 0) << "the case is meant to make the unguarded solve flip faces";
+}
+
 TEST(FlowHardCases, ThinPerforatedPlateOfGenus16) {
   const Mesh plate = test::perforated_plate(4, 4, 0.1, true);
   const Topology topology = build_topology(plate.F, plate.num_vertices());
   ASSERT_TRUE(topology.is_manifold());
   ASSERT_EQ(topology.genus(), 16);
   const FlowResult result = vertex_flow(plate.V, plate.F);
-  expect_flow_guarantees(plate, result, false);
-  std::cout << "perforated plate: " << result.report.flipped_before_guard << " faces flipped before the guard\n";
+  // At the defaults the projected solve leaves no bad face here (measured: 0 flipped, 0 below
+  // the floor); at the strong end of lambda (0.2) it flips 12 faces, which the guard repairs.
+  // Measured (as FlowOnMesh): defaults 0.438, 0 (flat faces: rounding), 0, +0.040, 0; lambda
+  // 0.2: 0.321, 0, 0, -0.050 (rho falls), 0.198.
+  expect_flow_effect(plate, result, {"perforated plate", 0.18, 1e-12, 1e-12, 0.016, 0.002});
+  FlowOptions strong;
+  strong.weights.lambda = 0.2;
+  const FlowResult strong_result = vertex_flow(plate.V, plate.F, strong);
+  expect_guard_had_work(strong_result);
+  expect_flow_effect(plate, strong_result, {"perforated plate, lambda 0.2", 0.13, 1e-12, 1e-12, -0.13, 0.4}, strong);
+  // The plate is 0.1 thick with edges of 0.25: no vertex ends nearer the opposite face than its
+  // own, with the rims' creases (default) and without them (only the projection's walk).
+  FlowOptions no_creases;
+  no_creases.feature_angle = 180;
+  const FlowResult smooth = vertex_flow(plate.V, plate.F, no_creases);
+  expect_promises_kept(plate, smooth, no_creases);
+  for (const Vertices* X : {&result.V, &smooth.V}) {
+    for (Index v = 0; v < plate.num_vertices(); ++v)
+      ASSERT_EQ(plate.V(v, 2) > 0.05, (*X)(v, 2) > 0.05) << "vertex " << v << " went through the plate";
+  }
+  EXPECT_GT(mean_displacement(smooth.V, plate.V), 0.01 * result.report.mean_edge_length);
 }
 
 TEST(FlowHardCases, OpenPlateWithHolesKeepsItsBoundaryLoops) {
@@ -124,7 +253,10 @@ TEST(FlowHardCases, OpenPlateWithHolesKeepsItsBoundaryLoops) {
   const Topology topology = build_topology(plate.F, plate.num_vertices());
   ASSERT_TRUE(topology.is_manifold());
   ASSERT_EQ(topology.boundary_loops.size(), 10u);  // 9 holes and the outer rim
-  expect_flow_guarantees(plate, vertex_flow(plate.V, plate.F));
+  const FlowResult result = vertex_flow(plate.V, plate.F);
+  expect_guard_had_work(result);  // measured: 80 flipped
+  // Measured: 0.238, 0 (flat faces), open, +0.031, 0.370.
+  expect_flow_effect(plate, result, {"open plate", 0.095, 1e-12, 0, 0.012, 0.74});
 }
 
 TEST(FlowHardCases, NoisyScanWithSlivers) {
@@ -133,8 +265,280 @@ TEST(FlowHardCases, NoisyScanWithSlivers) {
   ASSERT_GT((q.array() < 0.1).count(), scan.num_faces() / 100);  // really has slivers
   ASSERT_TRUE(degenerate_faces(scan.V, scan.F).empty());
   const FlowResult result = vertex_flow(scan.V, scan.F);
-  expect_flow_guarantees(scan, result, false);
-  std::cout << "noisy scan: " << result.report.flipped_before_guard << " faces flipped before the guard\n";
+  expect_guard_had_work(result);  // measured: 275 flipped
+  // Measured: 0.147, 0.016, 0.00026, +0.026, 0.096.
+  expect_flow_effect(scan, result, {"noisy scan", 0.059, 0.04, 0.00065, 0.01, 0.19});
+}
+
+// The guard itself (src/flow/guard.h), on a flat grid where the proposed move of one vertex
+// flips faces while every other vertex makes a small good move: the guard repairs the flipped
+// faces, shortens only vertices of bad faces, and leaves every other proposed move as it was.
+TEST(FlowGuard, RepairsBadFacesAndKeepsEveryGoodMove) {
+  const Mesh grid = test::saddle(5.0, 10);  // 11 x 11 vertices, spacing 1
+  Mesh flat = grid;
+  flat.V.col(2).setZero();
+  const Index n = flat.num_vertices();
+  const Topology topology = build_topology(flat.F, n);
+  const SurfaceFeatures features = detect_features(flat.V, flat.F, topology, 40.0);
+  std::vector<char> fixed(static_cast<std::size_t>(n), 0);
+  for (Index v = 0; v < n; ++v)
+    fixed[static_cast<std::size_t>(v)] = topology.is_boundary_vertex[static_cast<std::size_t>(v)];
+  // Every free vertex moves by 0.1 along a direction of its own; the centre vertex (5, 5) moves by
+  // 1.6 edge lengths, across its neighbours.
+  Vertices proposed = flat.V;
+  Index centre = -1;
+  for (Index v = 0; v < n; ++v) {
+    if (fixed[static_cast<std::size_t>(v)]) continue;
+    const double angle = 0.7 * static_cast<double>(v);
+    proposed.row(v) += 0.1 * Eigen::RowVector3d(std::cos(angle), std::sin(angle), 0);
+    if (flat.V.row(v).norm() < 1e-12) centre = v;
+  }
+  ASSERT_GE(centre, 0);
+  proposed.row(centre) = flat.V.row(centre) + Eigen::RowVector3d(1.6, 0.3, 0);
+  const std::vector<Index> flipped = flipped_faces(flat.V, proposed, flat.F);
+  ASSERT_FALSE(flipped.empty());
+  std::vector<char> on_bad_face(static_cast<std::size_t>(n), 0);
+  for (const Index f : flipped)
+    for (int k = 0; k < 3; ++k) on_bad_face[static_cast<std::size_t>(flat.F(f, k))] = 1;
+
+  FlowOptions options;
+  options.project_to_input = false;
+  options.min_quality = 0;  // only flips and degenerate faces
+  const GuardCriteria criteria = guard_criteria(flat.V, flat.F, options.min_quality);
+  Vertices X = proposed;
+  std::vector<char> shortened(static_cast<std::size_t>(n), 0);
+  FlowReport report;
+  guard(X, flat.V, flat.V, criteria, fixed, topology, features, options, shortened, report);
+  EXPECT_TRUE(flipped_faces(flat.V, X, flat.F).empty());
+  EXPECT_EQ(report.flipped_before_guard, static_cast<Index>(flipped.size()));
+  Index kept = 0;
+  for (Index v = 0; v < n; ++v) {
+    const auto i = static_cast<std::size_t>(v);
+    if (!shortened[i]) {
+      ASSERT_EQ(X.row(v), proposed.row(v)) << "vertex " << v << " was not shortened but moved";
+      ++kept;
+    } else {
+      // Shortened along its own move: anchor + step * proposed displacement, step in [0, 1).
+      const Eigen::RowVector3d d = proposed.row(v) - flat.V.row(v), got = X.row(v) - flat.V.row(v);
+      EXPECT_LT(got.norm(), d.norm()) << v;
+      EXPECT_LE((got - got.dot(d) / d.squaredNorm() * d).norm(), 1e-12) << v;
+    }
+  }
+  // Only the vertices of the flipped faces were shortened (their shortened moves flip nothing
+  // else here), the centre among them, and every other free vertex kept its move.
+  for (Index v = 0; v < n; ++v) {
+    if (shortened[static_cast<std::size_t>(v)]) {
+      EXPECT_TRUE(on_bad_face[static_cast<std::size_t>(v)]) << v;
+    }
+  }
+  EXPECT_TRUE(shortened[static_cast<std::size_t>(centre)]);
+  EXPECT_GE(kept, n - static_cast<Index>(std::count(on_bad_face.begin(), on_bad_face.end(), 1)));
+}
+
+// --- The projection's promises (surface_projection.h), measured directly. -------------------
+
+// The crease polylines of a mesh: for each crease vertex, the sharp edges of the chain of
+// crease vertices it lies on, up to the corners that end it (or the whole loop).
+std::vector<std::vector<Index>> crease_chain_of_vertex(const SurfaceFeatures& features, const Topology& topology) {
+  const std::size_t n = features.vertex_kind.size();
+  std::vector<int> chain_id(n, -1);
+  std::vector<std::vector<Index>> chains;
+  for (std::size_t start = 0; start < n; ++start) {
+    if (features.vertex_kind[start] != SurfaceFeatures::Kind::Crease || chain_id[start] >= 0) continue;
+    const int id = static_cast<int>(chains.size());
+    chains.emplace_back();
+    std::vector<Index> stack = {static_cast<Index>(start)};
+    chain_id[start] = id;
+    std::vector<char> edge_taken(features.sharp_edge.size(), 0);
+    while (!stack.empty()) {
+      const Index v = stack.back();
+      stack.pop_back();
+      for (const Index e : features.vertex_sharp[static_cast<std::size_t>(v)]) {
+        if (edge_taken[static_cast<std::size_t>(e)]) continue;
+        edge_taken[static_cast<std::size_t>(e)] = 1;
+        chains.back().push_back(e);
+        const Index w = topology.edges(e, 0) == v ? topology.edges(e, 1) : topology.edges(e, 0);
+        const auto j = static_cast<std::size_t>(w);
+        if (features.vertex_kind[j] == SurfaceFeatures::Kind::Crease && chain_id[j] < 0) {
+          chain_id[j] = id;
+          stack.push_back(w);
+        }
+      }
+    }
+  }
+  std::vector<std::vector<Index>> per_vertex(n);
+  for (std::size_t v = 0; v < n; ++v)
+    if (chain_id[v] >= 0) per_vertex[v] = chains[static_cast<std::size_t>(chain_id[v])];
+  return per_vertex;
+}
+
+double distance_to_segment(const Eigen::Vector3d& x, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  const double t = std::clamp((x - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+  return (a + t * (b - a) - x).norm();
+}
+
+struct FeatureMotion {
+  Index crease_vertices = 0, crease_vertices_moved = 0, corners = 0;
+  double worst_crease_distance = 0;  ///< from a crease vertex to its own crease, in edge lengths
+  double worst_patch_distance = 0;   ///< from a smooth vertex to its own patch's faces, in edge lengths
+};
+
+// Checks the feature promises of the flow's projection on (mesh, result) at `feature_angle`:
+// corners do not move, crease vertices end on their own input crease polyline, smooth vertices
+// end on (the Phong lift of) their own patch. Returns what it measured.
+FeatureMotion expect_features_kept(const Mesh& mesh, const Vertices& result, double feature_angle = 40.0) {
+  const Topology topology = build_topology(mesh.F, mesh.num_vertices());
+  const SurfaceFeatures features = detect_features(mesh.V, mesh.F, topology, feature_angle);
+  const double edge = mean_edge_length(mesh.V, topology);
+  const auto chains = crease_chain_of_vertex(features, topology);
+  FeatureMotion m;
+  std::vector<std::vector<Index>> patch_faces;
+  for (Index f = 0; f < mesh.num_faces(); ++f) {
+    const auto p = static_cast<std::size_t>(features.face_patch[static_cast<std::size_t>(f)]);
+    if (patch_faces.size() <= p) patch_faces.resize(p + 1);
+    patch_faces[p].push_back(f);
+  }
+  std::vector<std::vector<Index>> patch_vertices(patch_faces.size());
+  for (Index v = 0; v < mesh.num_vertices(); ++v) {
+    const auto i = static_cast<std::size_t>(v);
+    switch (features.vertex_kind[i]) {
+      case SurfaceFeatures::Kind::Corner:
+        ++m.corners;
+        EXPECT_EQ(result.row(v), mesh.V.row(v)) << "corner " << v << " moved";
+        break;
+      case SurfaceFeatures::Kind::Crease: {
+        ++m.crease_vertices;
+        double d = std::numeric_limits<double>::infinity();
+        for (const Index e : chains[i])
+          d = std::min(d, distance_to_segment(result.row(v).transpose(), mesh.V.row(topology.edges(e, 0)).transpose(),
+                                              mesh.V.row(topology.edges(e, 1)).transpose()));
+        m.worst_crease_distance = std::max(m.worst_crease_distance, d / edge);
+        m.crease_vertices_moved += (result.row(v) - mesh.V.row(v)).norm() > 0.01 * edge ? 1 : 0;
+        break;
+      }
+      case SurfaceFeatures::Kind::Smooth: {
+        if (topology.valence(v) == 0) break;
+        const Index f = topology.vertex_faces[static_cast<std::size_t>(topology.face_offsets[i])];
+        patch_vertices[static_cast<std::size_t>(features.face_patch[static_cast<std::size_t>(f)])].push_back(v);
+        break;
+      }
+    }
+  }
+  for (std::size_t p = 0; p < patch_faces.size(); ++p) {
+    if (patch_vertices[p].empty()) continue;
+    Faces F(static_cast<Index>(patch_faces[p].size()), 3);
+    for (std::size_t k = 0; k < patch_faces[p].size(); ++k)
+      F.row(static_cast<Index>(k)) = mesh.F.row(patch_faces[p][k]);
+    Vertices X(static_cast<Index>(patch_vertices[p].size()), 3);
+    for (std::size_t k = 0; k < patch_vertices[p].size(); ++k)
+      X.row(static_cast<Index>(k)) = result.row(patch_vertices[p][k]);
+    const Eigen::VectorXd d = DistanceQuery(mesh.V, F).squared_distances(X).cwiseSqrt();
+    m.worst_patch_distance = std::max(m.worst_patch_distance, d.maxCoeff() / edge);
+  }
+  EXPECT_LE(m.worst_crease_distance, 1e-9) << "a crease vertex left its crease";
+  return m;
+}
+
+// An elliptic cylinder with flat caps (a boss of a CAD part): two rims of 90-degree creases that
+// are closed loops without corners, along which the curvature varies (semi-axes 1.6 and 0.7), so
+// the flow slides rim vertices along the rims; rings along z graded towards the top.
+Mesh capped_elliptic_cylinder() {
+  const int around = 40, along = 8;
+  std::vector<Eigen::Vector3d> points;
+  auto ellipse = [&](int i, double scale, double z) {
+    const double t = 2 * M_PI * i / around;
+    return Eigen::Vector3d(1.6 * scale * std::cos(t), 0.7 * scale * std::sin(t), z);
+  };
+  for (int j = 0; j <= along; ++j)
+    for (int i = 0; i < around; ++i) points.push_back(ellipse(i, 1.0, 2.0 * std::pow(j / double(along), 0.7)));
+  const int inner_bottom = static_cast<int>(points.size());
+  for (int i = 0; i < around; ++i) points.push_back(ellipse(i, 0.6, 0.0));
+  const int inner_top = static_cast<int>(points.size());
+  for (int i = 0; i < around; ++i) points.push_back(ellipse(i, 0.6, 2.0));
+  const int centre_bottom = static_cast<int>(points.size());
+  points.emplace_back(0, 0, 0);
+  points.emplace_back(0, 0, 2);
+  const int centre_top = centre_bottom + 1;
+  std::vector<Eigen::Vector3i> faces;
+  auto ring = [&](int base, int i) { return base + (i % around); };
+  for (int j = 0; j < along; ++j)
+    for (int i = 0; i < around; ++i) {
+      const int a = ring(j * around, i), b = ring(j * around, i + 1), c = ring((j + 1) * around, i + 1),
+                d = ring((j + 1) * around, i);
+      faces.emplace_back(a, b, c);
+      faces.emplace_back(a, c, d);
+    }
+  const int top_rim = along * around;
+  for (int i = 0; i < around; ++i) {
+    // Bottom cap, facing -z: rim, inner ring, centre.
+    faces.emplace_back(ring(0, i), ring(inner_bottom, i), ring(0, i + 1));
+    faces.emplace_back(ring(0, i + 1), ring(inner_bottom, i), ring(inner_bottom, i + 1));
+    faces.emplace_back(ring(inner_bottom, i), centre_bottom, ring(inner_bottom, i + 1));
+    // Top cap, facing +z.
+    faces.emplace_back(ring(top_rim, i), ring(top_rim, i + 1), ring(inner_top, i));
+    faces.emplace_back(ring(top_rim, i + 1), ring(inner_top, i + 1), ring(inner_top, i));
+    faces.emplace_back(ring(inner_top, i), ring(inner_top, i + 1), centre_top);
+  }
+  Mesh mesh;
+  mesh.V.resize(static_cast<Index>(points.size()), 3);
+  for (std::size_t k = 0; k < points.size(); ++k) mesh.V.row(static_cast<Index>(k)) = points[k].transpose();
+  mesh.F.resize(static_cast<Index>(faces.size()), 3);
+  for (std::size_t k = 0; k < faces.size(); ++k) mesh.F.row(static_cast<Index>(k)) = faces[k].transpose();
+  return mesh;
+}
+
+TEST(FlowProjection, CreaseVerticesStayOnTheirCreasesAndCornersStay) {
+  struct Case {
+    std::string name;
+    Mesh mesh;
+    Index min_crease_moved;  // crease vertices that moved by > 0.01 edge lengths: the test has teeth
+  };
+  std::vector<Case> cases;
+  cases.push_back({"fandisk", read_mesh(test::data_path("fandisk.off")), 1});
+  cases.push_back({"chamfer-cube", read_mesh(test::data_path("chamfer-cube.off")), 0});
+  cases.push_back({"capped elliptic cylinder", capped_elliptic_cylinder(), 1});
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    const Topology topology = build_topology(c.mesh.F, c.mesh.num_vertices());
+    ASSERT_TRUE(topology.is_manifold() && topology.is_closed());
+    const FlowResult result = vertex_flow(c.mesh.V, c.mesh.F);
+    expect_promises_kept(c.mesh, result);
+    const FeatureMotion m = expect_features_kept(c.mesh, result.V);
+    std::cout << "[measured] " << c.name << ": " << m.crease_vertices << " crease vertices, " << m.crease_vertices_moved
+              << " moved, " << m.corners << " corners, worst crease distance " << m.worst_crease_distance
+              << ", worst patch distance " << m.worst_patch_distance << "\n";
+    EXPECT_GE(m.crease_vertices_moved, c.min_crease_moved);
+    EXPECT_LE(m.worst_patch_distance, 1.0);
+  }
+}
+
+// A thin slab (two faces 0.3 edge lengths apart) with the creases of its rims disabled
+// (feature_angle 180), so that only the walk keeps a point on its own side: a query point of a
+// top vertex pushed below the slab's mid-plane is nearer the bottom face, and a global
+// closest-point projection would put it there.
+TEST(FlowProjection, NoPointJumpsThroughAThinWall) {
+  const Mesh slab = test::perforated_plate(2, 2, 0.3, true);  // 5 x 5 cells, edges 0.5, 0.3 thick
+  const Topology topology = build_topology(slab.F, slab.num_vertices());
+  const SurfaceFeatures smooth = detect_features(slab.V, slab.F, topology, 180.0);
+  const double top = slab.V.col(2).maxCoeff(), bottom = slab.V.col(2).minCoeff();
+  std::vector<Index> rows;
+  Vertices queries = slab.V;
+  for (Index v = 0; v < slab.num_vertices(); ++v) {
+    // Top vertices away from the walls (all their faces on top): a wall vertex's query point
+    // would lie on the wall itself, which is its own surface.
+    bool inside = slab.V(v, 2) == top;
+    for (Index k = topology.face_offsets[static_cast<std::size_t>(v)];
+         inside && k < topology.face_offsets[static_cast<std::size_t>(v) + 1]; ++k) {
+      const Index f = topology.vertex_faces[static_cast<std::size_t>(k)];
+      for (int c = 0; c < 3; ++c) inside = inside && slab.V(slab.F(f, c), 2) == top;
+    }
+    if (!inside) continue;
+    rows.push_back(v);
+    queries(v, 2) = bottom + 0.3 * (top - bottom);  // nearer the bottom face
+  }
+  ASSERT_GT(rows.size(), 10u);
+  project_near_vertices(queries, rows, slab.V, slab.F, topology, smooth);
+  for (const Index v : rows) EXPECT_GT(queries(v, 2), 0.5 * (top + bottom)) << "vertex " << v << " jumped";
 }
 
 TEST(FlowProjection, VerticesStayOnTheInputSurfaceAndCreasesStayCrisp) {
@@ -157,22 +561,8 @@ TEST(FlowProjection, VerticesStayOnTheInputSurfaceAndCreasesStayCrisp) {
   EXPECT_LT(on.mean(), 0.01);
   EXPECT_LT(on.maxCoeff(), 0.1);
   EXPECT_GT(off.mean(), 2 * on.mean());
-  // Corners (fixed) do not move; the result keeps the input's sharp edges sharp: the number of
-  // edges whose dihedral angle exceeds 40 degrees does not drop.
-  auto sharp_edges = [&](const Vertices& X) {
-    const Topology t = build_topology(mesh.F, mesh.num_vertices());
-    Index count = 0;
-    for (Index f = 0; f < mesh.num_faces(); ++f) {
-      for (int k = 0; k < 3; ++k) {
-        const Index g = t.face_adjacency(f, k);
-        if (g <= f) continue;
-        const Eigen::Vector3d a = face_normal(X, mesh.F, f).normalized(), b = face_normal(X, mesh.F, g).normalized();
-        count += a.dot(b) < std::cos(40.0 * M_PI / 180.0) ? 1 : 0;
-      }
-    }
-    return count;
-  };
-  EXPECT_GE(sharp_edges(projected.V), 0.98 * static_cast<double>(sharp_edges(mesh.V)));
+  // Corners do not move, crease vertices stay on their creases (measured directly).
+  expect_features_kept(mesh, projected.V);
 }
 
 TEST(FlowProjection, FairnessTargetKeepsTheIcosahedronStill) {
@@ -242,13 +632,9 @@ TEST(Flow, RepeatedSolvesStartFromGuardedMeshes) {
   options.iterations = 5;
   FlowResult result;
   ASSERT_NO_THROW(result = vertex_flow(mesh.V, mesh.F, options));
-  // The guard's guarantees (five solves move vertices further than expect_flow_guarantees'
-  // one-solve bound of a mean edge length, so that check does not apply).
-  EXPECT_TRUE(result.V.allFinite());
-  EXPECT_TRUE(flipped_faces(mesh.V, result.V, mesh.F).empty());
-  EXPECT_TRUE(degenerate_faces(result.V, mesh.F).empty());
-  const Eigen::VectorXd q_in = triangle_quality(mesh.V, mesh.F), q_out = triangle_quality(result.V, mesh.F);
-  for (Index f = 0; f < mesh.num_faces(); ++f) ASSERT_GE(q_out[f], std::min(0.3, q_in[f]) - 1e-12) << "face " << f;
+  // Five solves move vertices further than one; the promises hold after each.
+  expect_promises_kept(mesh, result, options);
+  EXPECT_GT(mean_displacement(result.V, mesh.V), mean_displacement(vertex_flow(mesh.V, mesh.F).V, mesh.V));
 }
 
 TEST(Flow, RefusesNonManifoldAndEmptyMeshes) {
@@ -262,17 +648,75 @@ TEST(Flow, DeterministicBetweenRuns) {
   EXPECT_EQ(vertex_flow(mesh.V, mesh.F).V, vertex_flow(mesh.V, mesh.F).V);
 }
 
-TEST(Flow, GuardCountsOnlyVerticesItShortened) {
-  // max-planck-5k has slivers the unguarded solve flips; pin every third vertex.
-  const Mesh mesh = read_mesh(test::data_path("max-planck-5k.obj"));
+// FlowOptions::fix_boundary = false: boundary vertices move, over the input surface.
+TEST(Flow, FreeBoundaryMovesTheBoundaryOverTheInput) {
+  const Mesh mesh = read_mesh(test::data_path("hemisphere.off"));
   FlowOptions options;
-  for (Index v = 0; v < mesh.num_vertices(); v += 3) options.pinned.push_back(v);
+  options.fix_boundary = false;
   const FlowResult result = vertex_flow(mesh.V, mesh.F, options);
-  EXPECT_TRUE(flipped_faces(mesh.V, result.V, mesh.F).empty());
-  Index moved_less = 0;
-  for (Index v = 0; v < mesh.num_vertices(); ++v) moved_less += v % 3 != 0 ? 1 : 0;
-  EXPECT_LE(result.report.limited_vertices, moved_less);
-  for (Index v = 0; v < mesh.num_vertices(); v += 3) ASSERT_EQ(result.V.row(v), mesh.V.row(v));
+  expect_promises_kept(mesh, result, options);
+  const Topology topology = build_topology(mesh.F, mesh.num_vertices());
+  const DistanceQuery input(mesh.V, mesh.F);
+  Index moved = 0, boundary = 0;
+  double worst = 0;
+  for (Index v = 0; v < mesh.num_vertices(); ++v) {
+    if (!topology.is_boundary_vertex[static_cast<std::size_t>(v)]) continue;
+    ++boundary;
+    moved += (result.V.row(v) - mesh.V.row(v)).norm() > 0.01 * result.report.mean_edge_length ? 1 : 0;
+    worst = std::max(worst, std::sqrt(input.squared_distances(result.V.row(v)).maxCoeff()));
+  }
+  std::cout << "[measured] free boundary: " << moved << " of " << boundary
+            << " boundary vertices moved, worst distance " << worst / result.report.mean_edge_length << "\n";
+  EXPECT_GT(moved, boundary / 10);
+  EXPECT_LE(worst, 0.05 * result.report.mean_edge_length);
+  EXPECT_LT(result.report.fixed_vertices, vertex_flow(mesh.V, mesh.F).report.fixed_vertices);
+}
+
+// FlowOptions::feature_angle: at 180 nothing is a corner or a crease, so fandisk's corners
+// (held at the default 40 degrees) move.
+TEST(Flow, FeatureAngleDecidesWhichVerticesAreHeld) {
+  const Mesh mesh = read_mesh(test::data_path("fandisk.off"));
+  const Topology topology = build_topology(mesh.F, mesh.num_vertices());
+  const SurfaceFeatures features = detect_features(mesh.V, mesh.F, topology, 40.0);
+  FlowOptions options;
+  options.feature_angle = 180;
+  const FlowResult result = vertex_flow(mesh.V, mesh.F, options);
+  expect_promises_kept(mesh, result, options);
+  Index corners = 0, corners_moved = 0;
+  for (Index v = 0; v < mesh.num_vertices(); ++v) {
+    if (features.vertex_kind[static_cast<std::size_t>(v)] != SurfaceFeatures::Kind::Corner) continue;
+    ++corners;
+    corners_moved += (result.V.row(v) - mesh.V.row(v)).norm() > 0.01 * result.report.mean_edge_length ? 1 : 0;
+  }
+  std::cout << "[measured] feature angle 180: " << corners_moved << " of " << corners << " corners moved\n";
+  EXPECT_GT(corners_moved, corners / 4);
+  EXPECT_LT(result.report.fixed_vertices, vertex_flow(mesh.V, mesh.F).report.fixed_vertices);
+}
+
+// FlowOptions::max_halvings = 1: a vertex of a bad face goes straight back to where it started
+// (one solve: the input), where the default halves its move instead.
+TEST(Flow, OneHalvingSendsEveryLimitedVertexHome) {
+  const Mesh scan = test::noisy_scan(read_mesh(test::data_path("bunny_uniform.off")), 0.15, 0.6, 7);
+  // At the input up to the rounding of the normalised frame (flow.h: the flow runs on a
+  // translated, scaled copy; only fixed vertices are copied back bit for bit).
+  const double rounding = 1e-12 * bounding_box(scan.V).diagonal();
+  auto at_input = [&](const Vertices& X) {
+    Index count = 0;
+    for (Index v = 0; v < scan.num_vertices(); ++v) count += (X.row(v) - scan.V.row(v)).norm() <= rounding ? 1 : 0;
+    return count;
+  };
+  FlowOptions options;
+  options.max_halvings = 1;
+  const FlowResult once = vertex_flow(scan.V, scan.F, options), halved = vertex_flow(scan.V, scan.F);
+  expect_promises_kept(scan, once, options);
+  std::cout << "[measured] max_halvings 1: " << once.report.limited_vertices << " limited, " << at_input(once.V)
+            << " at the input; default: " << halved.report.limited_vertices << " limited, " << at_input(halved.V)
+            << " at the input\n";
+  ASSERT_GT(once.report.limited_vertices, 0);
+  // Every limited and every fixed vertex is at the input (and a few free vertices the solve did
+  // not move: 25 of the 5,314 measured).
+  EXPECT_GE(at_input(once.V), once.report.limited_vertices + once.report.fixed_vertices);
+  EXPECT_LT(at_input(halved.V), halved.report.limited_vertices + halved.report.fixed_vertices);
 }
 
 TEST(Flow, RejectsInvalidOptionsAndRepeatedVertexFaces) {
