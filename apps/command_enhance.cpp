@@ -215,6 +215,14 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
                    "Dihedral angle (degrees) above which an edge is a crease vertices slide along, not across")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  command
+      ->add_option("--solver", o->flow.solver,
+                   "Linear solver: automatic (default; flow.h says how it chooses), direct, iterative or multilevel")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, LinearSolver>{{"automatic", LinearSolver::Automatic},
+                                                                              {"direct", LinearSolver::Direct},
+                                                                              {"iterative", LinearSolver::Iterative},
+                                                                              {"multilevel", LinearSolver::Multilevel}},
+                                          CLI::ignore_case));
   command->add_option("--method", o->method, "flow (Ji et al.) or unsharp (geometric unsharp mask baseline)")
       ->check(CLI::IsMember({"flow", "unsharp"}))
       ->capture_default_str();
@@ -234,8 +242,8 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
   command->add_flag("--force", o->force, "Allow OUT to be the input file");
   command->callback([o, &global, command, weight, smoothing] {
     const bool unsharp = o->method == "unsharp";
-    for (const char* name :
-         {"--lambda", "--mu", "--iterations", "--min-quality", "--no-projection", "--fairness", "--feature-angle"})
+    for (const char* name : {"--lambda", "--mu", "--iterations", "--min-quality", "--no-projection", "--fairness",
+                             "--feature-angle", "--solver"})
       if (unsharp && command->count(name) > 0)
         throw std::runtime_error(std::string(name) + " applies to --method flow only");
     if (!unsharp && (weight->count() > 0 || smoothing->count() > 0))

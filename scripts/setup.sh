@@ -9,6 +9,7 @@ packages=(
   libsuitesparse-dev       # CHOLMOD sparse Cholesky (flow solver)
   libmetis-dev             # fill-reducing ordering for CHOLMOD
   libopenblas0-serial      # BLAS for CHOLMOD supernodal, one thread (CMakeLists.txt says why)
+  libopenblas0-pthread     # threaded BLAS, only for the test that results do not depend on BLAS threads
   libtbb-dev               # parallel loops
   libcgal-dev              # polygon triangulation, AABB trees, remeshing, QEM
   libgmp-dev libmpfr-dev   # CGAL's exact kernels
