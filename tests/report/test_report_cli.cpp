@@ -21,7 +21,17 @@ namespace {
 using test::run_cli;
 using test::shell_quote;
 
-std::string q(const std::filesystem::path& path) { return test::quoted(path); }
+std::string q(const std::filesystem::path& path) {
+  return test::quoted(path);
+}
+
+// fandisk at the defaults: mean displacement 0.46 mean edge lengths and rho 0.027 -> 0.498
+// measured (tests/flow's FlowOnMesh bounds): the flow ran, it was not replaced by the identity.
+void expect_the_flow_moved_fandisk(const nlohmann::json& report) {
+  EXPECT_GT(report["displacement_edge_lengths"]["mean"].get<double>(), 0.18);
+  EXPECT_GT(report["redistribution_rho"]["result"].get<double>(),
+            report["redistribution_rho"]["input"].get<double>() + 0.19);
+}
 
 TEST(CliReport, EnhanceWritesTheHtmlReportWithTheJsonMetrics) {
   test::ScratchDir dir("cli-report-enhance");
@@ -37,6 +47,7 @@ TEST(CliReport, EnhanceWritesTheHtmlReportWithTheJsonMetrics) {
   const std::size_t begin = page.find(open) + open.size();
   const auto data = nlohmann::json::parse(page.substr(begin, page.find("</script>", begin) - begin));
   EXPECT_EQ(data["metrics"], report);
+  expect_the_flow_moved_fandisk(report);
   EXPECT_EQ(data["labels"]["input"], "fandisk.off");
   EXPECT_EQ(data["labels"]["result"], "out.ply");
   EXPECT_NE(r.err.find("HTML report written to"), std::string::npos) << r.err;
@@ -99,6 +110,7 @@ TEST(CliReport, EnhanceReportHoldsTheFlowsOptionsAndReport) {
   EXPECT_EQ(report["solver"], expected["solver"]);
   EXPECT_EQ(report["guard"], expected["guard"]);
   EXPECT_EQ(read_mesh(out).V, flow.V);
+  EXPECT_GT(report["displacement_edge_lengths"]["mean"].get<double>(), 0.1);  // measured 0.40 with these options
 }
 
 // The baseline's report has its own sections, the same keys as before it had a path of its own:
@@ -141,6 +153,7 @@ TEST(CliReport, ReportOfAnExistingResult) {
   // The same metrics as enhance's own report (everything it measures, not the timings).
   const auto metrics = nlohmann::json::parse(test::read_text(json));
   const auto enhance = nlohmann::json::parse(test::read_text(dir.file("enhance.json")));
+  expect_the_flow_moved_fandisk(enhance);
   for (const char* key :
        {"vertices", "faces", "flipped_faces", "degenerate_faces", "quality_input", "quality_result",
         "redistribution_rho", "edge_error_cv", "displacement_edge_lengths", "volume_change_percent"}) {
