@@ -521,7 +521,7 @@ TEST(FlowProjection, CreaseVerticesStayOnTheirCreasesAndCornersStay) {
               << " moved, " << m.corners << " corners, worst crease distance " << m.worst_crease_distance
               << ", worst patch distance " << m.worst_patch_distance << "\n";
     EXPECT_GE(m.crease_vertices_moved, c.min_crease_moved);
-    EXPECT_LE(m.worst_patch_distance, 1.0);
+    EXPECT_LE(m.worst_patch_distance, 0.15);  // measured 0.054 (fandisk), 0.014 (cylinder): the Phong lift
   }
 }
 
@@ -571,9 +571,13 @@ TEST(FlowProjection, VerticesStayOnTheInputSurfaceAndCreasesStayCrisp) {
     return input_surface.squared_distances(X).cwiseSqrt();
   };
   const Eigen::VectorXd on = distance_to_input(projected.V) / edge, off = distance_to_input(free.V) / edge;
-  EXPECT_LT(on.mean(), 0.01);
-  EXPECT_LT(on.maxCoeff(), 0.1);
-  EXPECT_GT(off.mean(), 2 * on.mean());
+  std::cout << "[measured] fandisk distance to the input in edge lengths: projected mean " << on.mean() << " max "
+            << on.maxCoeff() << ", unprojected mean " << off.mean() << "\n";
+  // Measured: projected mean 0.0022 and max 0.054 (the Phong lift of the curved parts),
+  // unprojected mean 0.018 (8.3x).
+  EXPECT_LT(on.mean(), 0.0055);
+  EXPECT_LT(on.maxCoeff(), 0.14);
+  EXPECT_GT(off.mean(), 3 * on.mean());
   // Corners do not move, crease vertices stay on their creases (measured directly).
   expect_features_kept(mesh, projected.V);
 }
