@@ -126,7 +126,7 @@ TEST(CliEnhanceOptions, FairnessZeroShrinksTheIcosahedron) {
         o.project_to_input = false;
       });
   const double volume = signed_volume(mesh.V, mesh.F);
-  EXPECT_LT(signed_volume(r.V, mesh.F), 0.99 * volume);
+  EXPECT_LT(signed_volume(r.V, mesh.F), 0.98 * volume);  // measured -5% (flow.h)
   const Vertices still = enhance_with("icosahedron_binary.stl", "--fairness input-normal --no-projection");
   EXPECT_NEAR(signed_volume(still, mesh.F), volume, 1e-9 * volume);
 }

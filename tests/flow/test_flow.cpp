@@ -592,7 +592,7 @@ TEST(FlowProjection, FairnessTargetKeepsTheIcosahedronStill) {
   FlowOptions ours = paper;
   ours.weights.fairness_target = FairnessTarget::InputNormal;
   const double volume = signed_volume(ico.V, ico.F);
-  EXPECT_LT(signed_volume(vertex_flow(ico.V, ico.F, paper).V, ico.F), 0.99 * volume);
+  EXPECT_LT(signed_volume(vertex_flow(ico.V, ico.F, paper).V, ico.F), 0.98 * volume);  // measured -5% (flow.h)
   EXPECT_NEAR(signed_volume(vertex_flow(ico.V, ico.F, ours).V, ico.F), volume, 1e-9 * volume);
 }
 
@@ -688,8 +688,8 @@ TEST(Flow, FreeBoundaryMovesTheBoundaryOverTheInput) {
   }
   std::cout << "[measured] free boundary: " << moved << " of " << boundary
             << " boundary vertices moved, worst distance " << worst / result.report.mean_edge_length << "\n";
-  EXPECT_GT(moved, boundary / 10);
-  EXPECT_LE(worst, 0.05 * result.report.mean_edge_length);
+  EXPECT_GT(moved, boundary / 2);                            // measured: all 120
+  EXPECT_LE(worst, 0.016 * result.report.mean_edge_length);  // measured 0.0063
   EXPECT_LT(result.report.fixed_vertices, vertex_flow(mesh.V, mesh.F).report.fixed_vertices);
 }
 
@@ -710,7 +710,7 @@ TEST(Flow, FeatureAngleDecidesWhichVerticesAreHeld) {
     corners_moved += (result.V.row(v) - mesh.V.row(v)).norm() > 0.01 * result.report.mean_edge_length ? 1 : 0;
   }
   std::cout << "[measured] feature angle 180: " << corners_moved << " of " << corners << " corners moved\n";
-  EXPECT_GT(corners_moved, corners / 4);
+  EXPECT_GT(corners_moved, corners / 2);  // measured: all 22
   EXPECT_LT(result.report.fixed_vertices, vertex_flow(mesh.V, mesh.F).report.fixed_vertices);
 }
 
