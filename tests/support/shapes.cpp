@@ -3,9 +3,12 @@
 #include "vertexflow/curvature.h"
 #include "vertexflow/topology.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <random>
+#include <set>
 #include <vector>
 
 namespace vertexflow::test {
@@ -39,6 +42,52 @@ void grid_triangles(int rows, int cols, const auto& index, std::vector<Eigen::Ve
 }
 
 }  // namespace
+
+Mesh vertex_clustered(const Mesh& mesh, double cell) {
+  std::map<std::array<long long, 3>, int> cluster_of_cell;
+  std::vector<int> cluster(static_cast<std::size_t>(mesh.num_vertices()));
+  std::vector<Eigen::Vector3d> sum;
+  std::vector<int> count;
+  for (Index v = 0; v < mesh.num_vertices(); ++v) {
+    std::array<long long, 3> key{};
+    for (int k = 0; k < 3; ++k)
+      key[static_cast<std::size_t>(k)] = static_cast<long long>(std::floor(mesh.V(v, k) / cell));
+    const auto [it, added] = cluster_of_cell.emplace(key, static_cast<int>(sum.size()));
+    if (added) {
+      sum.emplace_back(Eigen::Vector3d::Zero());
+      count.push_back(0);
+    }
+    cluster[static_cast<std::size_t>(v)] = it->second;
+    sum[static_cast<std::size_t>(it->second)] += mesh.V.row(v).transpose();
+    ++count[static_cast<std::size_t>(it->second)];
+  }
+  std::vector<Eigen::Vector3d> points;
+  for (std::size_t c = 0; c < sum.size(); ++c) points.push_back(sum[c] / count[c]);
+  std::vector<Eigen::Vector3i> triangles;
+  std::set<std::array<int, 3>> seen;
+  for (Index f = 0; f < mesh.num_faces(); ++f) {
+    const Eigen::Vector3i t(cluster[static_cast<std::size_t>(mesh.F(f, 0))],
+                            cluster[static_cast<std::size_t>(mesh.F(f, 1))],
+                            cluster[static_cast<std::size_t>(mesh.F(f, 2))]);
+    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2]) continue;
+    std::array<int, 3> key{t[0], t[1], t[2]};
+    std::sort(key.begin(), key.end());
+    if (seen.insert(key).second) triangles.push_back(t);
+  }
+  // Drop the clusters no face uses; the others are numbered in the order faces first use them.
+  std::vector<int> remap(points.size(), -1);
+  std::vector<Eigen::Vector3d> used;
+  for (auto& t : triangles)
+    for (int k = 0; k < 3; ++k) {
+      int& r = remap[static_cast<std::size_t>(t[k])];
+      if (r < 0) {
+        r = static_cast<int>(used.size());
+        used.push_back(points[static_cast<std::size_t>(t[k])]);
+      }
+      t[k] = r;
+    }
+  return from_lists(used, triangles);
+}
 
 Mesh icosphere(double radius, int levels) {
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;

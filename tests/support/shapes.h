@@ -33,6 +33,13 @@ Mesh bowtie();
 /// sheet-metal-like CAD part). Outward orientation.
 Mesh perforated_plate(int holes, int subdivisions, double thickness, bool bottom);
 
+/// Vertex-clustering decimation of `mesh` (Rossignac and Borrel 1993), the way the Stanford
+/// repository's low-resolution scans were made: vertices are merged per cube of a grid of
+/// `cell` edge length (at the mean of the cube's vertices), faces with two corners in one cube
+/// are dropped, repeated faces kept once. Like those scans the result has non-manifold edges
+/// and vertices.
+Mesh vertex_clustered(const Mesh& mesh, double cell);
+
 /// A simulated noisy scan of `mesh`: every vertex displaced along its normal by Gaussian noise
 /// of `normal_noise` mean edge lengths and in the tangent plane by up to `tangential_jitter`
 /// mean edge lengths (uniform), which turns many triangles into slivers; fixed seed.
