@@ -5,6 +5,7 @@
 
 #include "vertexflow/flow.h"
 #include "vertexflow/html_report.h"
+#include "vertexflow/manifold_split.h"
 #include "vertexflow/report_json.h"
 #include "vertexflow/timing.h"
 #include "vertexflow/topology.h"
@@ -150,7 +151,8 @@ struct MethodRun {
 using Progress = std::function<void(const std::string&)>;
 
 // The flow, with the caller's topology of mesh.F. Report: options, solver, guard, seconds.
-MethodRun run_flow(const Mesh& mesh, const Topology& topology, const FlowOptions& options, const Progress& phase) {
+MethodRun run_flow(const Mesh& mesh, const Topology& topology, const FlowOptions& options, const Progress& phase,
+                   const Progress& warn) {
   FlowResult result = vertex_flow(mesh.V, mesh.F, topology, options);
   const FlowReport& r = result.report;
   phase(fmt::format(
@@ -158,6 +160,11 @@ MethodRun run_flow(const Mesh& mesh, const Topology& topology, const FlowOptions
       "limited by the guard",
       r.seconds_curvature, r.seconds_assembly, r.seconds_solve, r.seconds_projection, r.seconds_guard,
       r.limited_vertices));
+  if (r.held_non_manifold_vertices + r.reoriented_faces + r.cut_edges > 0)
+    warn(
+        fmt::format("the mesh is not manifold or not consistently oriented: {} vertices held (their faces form more "
+                    "than one fan), {} faces reoriented, {} edges treated as boundaries; --strict refuses such meshes",
+                    r.held_non_manifold_vertices, r.reoriented_faces, r.cut_edges));
   MethodRun run;
   run.report = r;
   run.report["options"] = options;
@@ -176,6 +183,32 @@ MethodRun run_unsharp(const Mesh& mesh, const UnsharpOptions& options) {
   run.report["seconds"] = {{"unsharp", seconds}};
   run.V = std::move(result.V);
   return run;
+}
+
+// The pair of meshes the report measures: input and result as they are, or, when the input is
+// not manifold or not consistently oriented, their manifold split (both with the split's faces).
+struct MeasuredPair {
+  Mesh input, result;
+  Topology topology;
+};
+
+MeasuredPair measured_pair(const Mesh& input, const Mesh& result, const Topology& topology) {
+  MeasuredPair pair;
+  if (topology.is_manifold() && topology.is_oriented) {
+    pair.input = input;
+    pair.result = result;
+    pair.topology = topology;
+    return pair;
+  }
+  const ManifoldSplit split = split_non_manifold(input.V, input.F, topology);
+  pair.input.V = split.V;
+  pair.input.F = split.F;
+  pair.result.F = split.F;
+  pair.result.V.resize(split.V.rows(), 3);
+  for (Index s = 0; s < split.V.rows(); ++s)
+    pair.result.V.row(s) = result.V.row(split.source_vertex[static_cast<std::size_t>(s)]);
+  pair.topology = build_topology(split.F, split.V.rows());
+  return pair;
 }
 
 }  // namespace
@@ -236,6 +269,9 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
                                ->capture_default_str();
   command->add_option("--pin", o->pin_file, "File of vertex indices (0-based) to hold in place");
   command->add_flag("--free-boundary", o->keep_boundary_free, "Let boundary vertices move (default: fixed)");
+  command->add_flag("--strict", o->flow.refuse_non_manifold,
+                    "Refuse a non-manifold or inconsistently oriented mesh (default: hold its non-manifold vertices "
+                    "and flow the rest)");
   command->add_option("--report", o->report_file, "Write a JSON report: options, timings per phase, metrics");
   command->add_option("--html", o->html_file,
                       "Write an HTML report: both meshes in 3D, colour maps, histograms, metrics");
@@ -253,6 +289,9 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     if (!o->pin_file.empty()) check_pin_file(o->pin_file);
     auto phase = [&](const std::string& what) {
       if (!global.quiet) fmt::print(stderr, "vertexflow: {}\n", what);
+    };
+    auto warn = [&](const std::string& what) {
+      if (!global.quiet) fmt::print(stderr, "vertexflow: warning: {}: {}\n", o->input, what);
     };
     auto start = std::chrono::steady_clock::now();
     phase("reading " + o->input);
@@ -279,7 +318,7 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
         run = run_unsharp(mesh, o->unsharp);
       } else {
         topology = build_topology(mesh.F, mesh.num_vertices());
-        run = run_flow(mesh, topology, o->flow, phase);
+        run = run_flow(mesh, topology, o->flow, phase, warn);
       }
     } catch (const std::invalid_argument& e) {
       throw std::runtime_error(o->input + ": " + e.what());
@@ -298,9 +337,13 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
 
     if (!o->report_file.empty() || !o->html_file.empty()) {
       if (unsharp) topology = build_topology(mesh.F, mesh.num_vertices());
+      // A non-manifold or inconsistently oriented input is measured and drawn as the manifold
+      // split the flow ran on (manifold_split.h): the same surface, held vertices duplicated.
+      const MeasuredPair measured = measured_pair(mesh, out, topology);
       // Each mesh's curvature, computed once for the metrics and the HTML report.
-      const ReportCurvatures curvatures = report_curvatures(mesh, out, topology);
-      nlohmann::json report = flow_metrics(mesh, out, topology, curvatures);
+      const ReportCurvatures curvatures = report_curvatures(measured.input, measured.result, measured.topology);
+      nlohmann::json report = flow_metrics(measured.input, measured.result, measured.topology, curvatures);
+      report["vertices"] = mesh.num_vertices();
       report.update(run.report);
       report["seconds"]["read"] = seconds_read;
       report["seconds"]["write"] = seconds_write;
@@ -312,8 +355,8 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
         phase("report written to " + o->report_file);
       }
       if (!o->html_file.empty()) {
-        write_html_report(o->html_file, mesh, out, curvatures.input, curvatures.result, report.dump(),
-                          html_report_options(o->input, o->output));
+        write_html_report(o->html_file, measured.input, measured.result, curvatures.input, curvatures.result,
+                          report.dump(), html_report_options(o->input, o->output));
         phase("HTML report written to " + o->html_file);
       }
     }

@@ -12,7 +12,12 @@
 // turns by more than 90 degrees relative to the input and no face becomes degenerate. A face
 // that would is repaired by halving the displacement of its vertices (per vertex, repeatedly,
 // like CGAL's tangential relaxation step control); FlowReport counts the vertices limited.
-// Non-manifold meshes are refused (std::invalid_argument), as topology.h states.
+//
+// Non-manifold or inconsistently oriented meshes (scans, CAD exports) are flowed on their
+// manifold split (manifold_split.h): faces oriented per component, edges of more than two faces
+// cut, and every vertex whose neighbourhood is not one disc held where it is, bit for bit; the
+// rest flows. The result has the input's vertices and faces, in order. FlowReport counts what
+// was held; FlowOptions::refuse_non_manifold refuses such meshes instead.
 //
 // Side effect: the sparse Cholesky runs with one BLAS thread, and vertex_flow sets the process's
 // OpenBLAS thread count to 1 (when OpenBLAS is the BLAS): Debian's threaded OpenBLAS made the
@@ -93,6 +98,10 @@ struct FlowOptions {
   bool fix_boundary = true;
   /// Vertices held in place (indices into V).
   std::vector<Index> pinned;
+  /// Refuse (std::invalid_argument) a mesh that is not manifold or not consistently oriented
+  /// instead of flowing its manifold split with the non-manifold vertices held (the CLI's
+  /// --strict).
+  bool refuse_non_manifold = false;
   /// Halvings of a vertex's displacement before it is set to zero by the guard.
   int max_halvings = 30;
   /// The guard also treats as bad a face whose radius ratio 2r/R (quality.h) falls below
@@ -122,6 +131,10 @@ struct FlowReport {
   Index low_quality_before_guard = 0;  ///< faces it left below their quality floor
   Index limited_vertices = 0;          ///< vertices whose displacement the guard shortened (any solve)
   Index fixed_vertices = 0;            ///< boundary, pinned, isolated and corner vertices
+  /// Non-manifold input (manifold_split.h), all 0 for a manifold, oriented mesh:
+  Index held_non_manifold_vertices = 0;  ///< vertices held because their faces form more than one fan
+  Index reoriented_faces = 0;            ///< faces whose orientation disagreed with their component's
+  Index cut_edges = 0;                   ///< edges treated as boundaries (non-manifold, orientation conflicts)
   double seconds_curvature = 0, seconds_assembly = 0, seconds_solve = 0, seconds_projection = 0, seconds_guard = 0;
   /// Direct: CHOLMOD's analysis and numeric factorisation; iterative: the preconditioner's set-up.
   double seconds_factorization = 0;
@@ -143,7 +156,7 @@ void validate_flow_options(const FlowOptions& options, Index num_vertices = -1);
 
 /// Moves the vertices of (V, F) by vertex flow. Throws std::invalid_argument for options out
 /// of range (validate_flow_options), an empty mesh, a non-finite coordinate, a mesh without
-/// extent, or a non-manifold mesh.
+/// extent, or (with refuse_non_manifold) a non-manifold or inconsistently oriented mesh.
 FlowResult vertex_flow(const Vertices& V, const Faces& F, const FlowOptions& options = {});
 
 /// The same with the topology of F (build_topology(F, V.rows())) computed by the caller, who

@@ -6,9 +6,10 @@
 // - Topology is computed for any triangle list, manifold or not, and reports what is wrong
 //   (non_manifold_edges, non_manifold_vertices, is_oriented). One-rings are in cyclic order
 //   only at manifold vertices.
-// - Stages that need a manifold surface (curvature, flow) check `is_manifold()` and refuse
-//   non-manifold input with std::invalid_argument (describe_non_manifold: the counts and an
-//   offending vertex); they do not silently process part of a mesh.
+// - The flow runs on the manifold split of a non-manifold mesh (manifold_split.h), holding the
+//   vertices that are not discs. The other stages that need a manifold surface (curvature, the
+//   metrics) check `is_manifold()` and refuse non-manifold input with std::invalid_argument
+//   (describe_non_manifold: the counts and an offending vertex).
 #pragma once
 
 #include "vertexflow/mesh.h"

@@ -7,6 +7,7 @@
 #include "flow_solver.h"
 #include "guard.h"
 #include "surface_projection.h"
+#include "vertexflow/manifold_split.h"
 #include "vertexflow/timing.h"
 
 #include <algorithm>
@@ -39,6 +40,41 @@ void validate_flow_options(const FlowOptions& o, Index num_vertices) {
                                   std::to_string(num_vertices) + ")");
 }
 
+namespace {
+
+// Flows the manifold split of a non-manifold or inconsistently oriented mesh (flow.h): the
+// copies of held vertices are pinned, so every input vertex has one position to return.
+FlowResult flow_on_manifold_split(const Vertices& V, const Faces& F, const Topology& topology,
+                                  const FlowOptions& options) {
+  const ManifoldSplit split = split_non_manifold(V, F, topology);
+  FlowOptions on_split = options;
+  on_split.refuse_non_manifold = true;  // the split is manifold and oriented (manifold_split.h)
+  on_split.pinned.clear();
+  auto pin_copies = [&](Index v) {
+    for (Index s = split.first_copy[static_cast<std::size_t>(v)]; s < split.first_copy[static_cast<std::size_t>(v) + 1];
+         ++s)
+      on_split.pinned.push_back(s);
+  };
+  for (const Index v : options.pinned) pin_copies(v);
+  for (Index v = 0; v < static_cast<Index>(V.rows()); ++v)
+    if (split.held[static_cast<std::size_t>(v)]) pin_copies(v);
+  FlowResult on_copies = vertex_flow(split.V, split.F, build_topology(split.F, split.V.rows()), on_split);
+  FlowResult result;
+  result.report = on_copies.report;
+  result.V = V;
+  for (Index v = 0; v < static_cast<Index>(V.rows()); ++v)
+    if (!split.held[static_cast<std::size_t>(v)])
+      result.V.row(v) = on_copies.V.row(split.first_copy[static_cast<std::size_t>(v)]);
+  // Counted per input vertex: a held vertex's extra copies were fixed too.
+  result.report.fixed_vertices -= static_cast<Index>(split.V.rows()) - static_cast<Index>(V.rows());
+  result.report.held_non_manifold_vertices = split.held_vertices;
+  result.report.reoriented_faces = split.reversed_faces;
+  result.report.cut_edges = split.cut_non_manifold_edges + split.cut_orientation_edges;
+  return result;
+}
+
+}  // namespace
+
 FlowResult vertex_flow(const Vertices& V, const Faces& F, const FlowOptions& options) {
   // Options are validated by the overload below; the topology needs a non-empty mesh first.
   if (V.rows() == 0 || F.rows() == 0) throw std::invalid_argument("vertex flow: the mesh is empty");
@@ -58,7 +94,13 @@ FlowResult vertex_flow(const Vertices& V, const Faces& F, const Topology& topolo
     throw std::invalid_argument(
         "vertex flow: the bounding box has zero size (all vertices at one point, or coordinates too small to compute "
         "with)");
-  if (!topology.is_manifold()) throw std::invalid_argument("vertex flow: " + describe_non_manifold(topology));
+  if (!topology.is_manifold() || !topology.is_oriented) {
+    if (options.refuse_non_manifold)
+      throw std::invalid_argument("vertex flow: " + (topology.is_manifold()
+                                                         ? std::string("the faces are not consistently oriented")
+                                                         : describe_non_manifold(topology)));
+    return flow_on_manifold_split(V, F, topology, options);
+  }
   FlowResult result;
   FlowReport& report = result.report;
 

@@ -159,7 +159,7 @@ TEST(CliEnhance, WritesTheMeshAndAReport) {
     EXPECT_GE(j["seconds"][phase].get<double>(), 0.0) << phase;
 }
 
-TEST(CliEnhance, BadPinFileAndNonManifoldInputFailCleanly) {
+TEST(CliEnhance, BadPinFileFailsCleanly) {
   test::ScratchDir dir("cli-enhance-bad");
   const auto pins = dir.file("pins.txt");
   { std::ofstream(pins) << "12 banana\n"; }
@@ -169,12 +169,30 @@ TEST(CliEnhance, BadPinFileAndNonManifoldInputFailCleanly) {
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("line 1: 'banana' is not a vertex index"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(out));
-  const auto bowtie = dir.file("bowtie.obj");
+}
+
+// A non-manifold mesh (a bowtie: two triangles sharing only vertex 1) is flowed with its
+// non-manifold vertex held, and says so in one warning line; --strict refuses it in one line.
+TEST(CliEnhance, NonManifoldInputIsHeldWhereItMustBeOrRefusedWithStrict) {
+  test::ScratchDir dir("cli-enhance-non-manifold");
+  const auto bowtie = dir.file("bowtie.obj"), out = dir.file("out.obj"), report = dir.file("r.json");
   { std::ofstream(bowtie) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv -1 0 0\nv 0 -1 0\nf 1 2 3\nf 1 4 5\n"; }
-  const auto nm = run_cli("--quiet enhance " + shell_quote(bowtie.string()) + " " + shell_quote(out.string()));
-  EXPECT_EQ(nm.exit_code, 1);
-  EXPECT_NE(nm.err.find("bowtie.obj: vertex flow: the mesh is not manifold"), std::string::npos) << nm.err;
-  EXPECT_EQ(std::count(nm.err.begin(), nm.err.end(), '\n'), 1) << nm.err;
+  const auto held = run_cli("enhance " + shell_quote(bowtie.string()) + " " + shell_quote(out.string()) + " --report " +
+                            shell_quote(report.string()));
+  EXPECT_EQ(held.exit_code, 0) << held.err;
+  EXPECT_NE(held.err.find("bowtie.obj: the mesh is not manifold or not consistently oriented: 1 vertices held"),
+            std::string::npos)
+      << held.err;
+  const auto json = nlohmann::json::parse(test::read_text(report));
+  EXPECT_EQ(json["non_manifold"]["held_vertices"], 1);
+  EXPECT_EQ(json["vertices"], 5);
+  EXPECT_EQ(read_mesh(out).V, read_mesh(bowtie).V);  // every vertex on the boundary or held
+  std::filesystem::remove(out);
+  const auto strict =
+      run_cli("--quiet enhance " + shell_quote(bowtie.string()) + " " + shell_quote(out.string()) + " --strict");
+  EXPECT_EQ(strict.exit_code, 1);
+  EXPECT_NE(strict.err.find("bowtie.obj: vertex flow: the mesh is not manifold"), std::string::npos) << strict.err;
+  EXPECT_EQ(std::count(strict.err.begin(), strict.err.end(), '\n'), 1) << strict.err;
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 

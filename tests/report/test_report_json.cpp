@@ -62,8 +62,8 @@ TEST(ReportJson, CurvatureOptionsEveryField) {
 
 TEST(ReportJson, FlowOptionsEveryField) {
   FlowOptions options;
-  auto& [weights, d_percentile, iterations, project_to_input, feature_angle, fix_boundary, pinned, max_halvings,
-         min_quality, curvature, solver, solver_tolerance] = options;
+  auto& [weights, d_percentile, iterations, project_to_input, feature_angle, fix_boundary, pinned, refuse_non_manifold,
+         max_halvings, min_quality, curvature, solver, solver_tolerance] = options;
   weights.lambda = 0.25;
   weights.mu = 0.75;
   weights.epsilon = 1e-4;
@@ -74,6 +74,7 @@ TEST(ReportJson, FlowOptionsEveryField) {
   feature_angle = 30;
   fix_boundary = false;
   pinned = {4, 8, 15};
+  refuse_non_manifold = true;
   max_halvings = 12;
   min_quality = 0.2;
   curvature.normal_weighting = NormalWeighting::Area;
@@ -85,7 +86,7 @@ TEST(ReportJson, FlowOptionsEveryField) {
   EXPECT_EQ(j, nlohmann::json::parse(R"({
     "lambda": 0.25, "mu": 0.75, "epsilon": 1e-4, "fairness_target": "zero",
     "d_percentile": 95.0, "iterations": 3, "project_to_input": false, "feature_angle": 30.0,
-    "fix_boundary": false, "pinned": 3, "max_halvings": 12, "min_quality": 0.2,
+    "fix_boundary": false, "pinned": 3, "refuse_non_manifold": true, "max_halvings": 12, "min_quality": 0.2,
     "curvature": {"normal_weighting": "area", "smoothing_rounds": 1},
     "solver": "conjugate gradients, multilevel", "solver_tolerance": 1e-9})"));
   expect_every_value_differs(j, FlowOptions{});
@@ -95,8 +96,9 @@ TEST(ReportJson, FlowOptionsEveryField) {
 TEST(ReportJson, FlowReportEveryFieldInItsSection) {
   FlowReport report;
   auto& [mean_edge_length, d, solver_error, flipped_before_guard, low_quality_before_guard, limited_vertices,
-         fixed_vertices, seconds_curvature, seconds_assembly, seconds_solve, seconds_projection, seconds_guard,
-         seconds_factorization, solver_used, solver_iterations] = report;
+         fixed_vertices, held_non_manifold_vertices, reoriented_faces, cut_edges, seconds_curvature, seconds_assembly,
+         seconds_solve, seconds_projection, seconds_guard, seconds_factorization, solver_used, solver_iterations] =
+      report;
   mean_edge_length = 0.5;
   d = 2.5;
   solver_error = 1e-8;
@@ -104,6 +106,9 @@ TEST(ReportJson, FlowReportEveryFieldInItsSection) {
   low_quality_before_guard = 2;
   limited_vertices = 3;
   fixed_vertices = 4;
+  held_non_manifold_vertices = 5;
+  reoriented_faces = 6;
+  cut_edges = 7;
   seconds_curvature = 0.125;
   seconds_assembly = 0.25;
   seconds_solve = 0.375;
@@ -124,6 +129,7 @@ TEST(ReportJson, FlowReportEveryFieldInItsSection) {
                                      {"faces_low_quality_before_guard", 2},
                                      {"limited_vertices", 3},
                                      {"fixed_vertices", 4}}},
+                                   {"non_manifold", {{"held_vertices", 5}, {"reoriented_faces", 6}, {"cut_edges", 7}}},
                                    {"seconds",
                                     {{"curvature", 0.125},
                                      {"assembly", 0.25},
@@ -133,7 +139,8 @@ TEST(ReportJson, FlowReportEveryFieldInItsSection) {
                                      {"factorization", 0.75}}}};
   EXPECT_EQ(j, expected);
   const nlohmann::json defaults = FlowReport{};
-  for (const char* section : {"solver", "guard", "seconds"}) expect_every_value_differs(j[section], defaults[section]);
+  for (const char* section : {"solver", "guard", "non_manifold", "seconds"})
+    expect_every_value_differs(j[section], defaults[section]);
 }
 
 TEST(ReportJson, UnsharpOptionsAndResultEveryField) {
