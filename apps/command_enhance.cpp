@@ -5,7 +5,6 @@
 
 #include "vertexflow/flow.h"
 #include "vertexflow/html_report.h"
-#include "vertexflow/manifold_split.h"
 #include "vertexflow/report_json.h"
 #include "vertexflow/timing.h"
 #include "vertexflow/topology.h"
@@ -185,32 +184,6 @@ MethodRun run_unsharp(const Mesh& mesh, const UnsharpOptions& options) {
   return run;
 }
 
-// The pair of meshes the report measures: input and result as they are, or, when the input is
-// not manifold or not consistently oriented, their manifold split (both with the split's faces).
-struct MeasuredPair {
-  Mesh input, result;
-  Topology topology;
-};
-
-MeasuredPair measured_pair(const Mesh& input, const Mesh& result, const Topology& topology) {
-  MeasuredPair pair;
-  if (topology.is_manifold() && topology.is_oriented) {
-    pair.input = input;
-    pair.result = result;
-    pair.topology = topology;
-    return pair;
-  }
-  const ManifoldSplit split = split_non_manifold(input.V, input.F, topology);
-  pair.input.V = split.V;
-  pair.input.F = split.F;
-  pair.result.F = split.F;
-  pair.result.V.resize(split.V.rows(), 3);
-  for (Index s = 0; s < split.V.rows(); ++s)
-    pair.result.V.row(s) = result.V.row(split.source_vertex[static_cast<std::size_t>(s)]);
-  pair.topology = build_topology(split.F, split.V.rows());
-  return pair;
-}
-
 }  // namespace
 
 void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
@@ -337,13 +310,9 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
 
     if (!o->report_file.empty() || !o->html_file.empty()) {
       if (unsharp) topology = build_topology(mesh.F, mesh.num_vertices());
-      // A non-manifold or inconsistently oriented input is measured and drawn as the manifold
-      // split the flow ran on (manifold_split.h): the same surface, held vertices duplicated.
-      const MeasuredPair measured = measured_pair(mesh, out, topology);
       // Each mesh's curvature, computed once for the metrics and the HTML report.
-      const ReportCurvatures curvatures = report_curvatures(measured.input, measured.result, measured.topology);
-      nlohmann::json report = flow_metrics(measured.input, measured.result, measured.topology, curvatures);
-      report["vertices"] = mesh.num_vertices();
+      const ReportCurvatures curvatures = report_curvatures(mesh, out, topology);
+      nlohmann::json report = flow_metrics(mesh, out, topology, curvatures);
       report.update(run.report);
       report["seconds"]["read"] = seconds_read;
       report["seconds"]["write"] = seconds_write;
@@ -355,8 +324,8 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
         phase("report written to " + o->report_file);
       }
       if (!o->html_file.empty()) {
-        write_html_report(o->html_file, measured.input, measured.result, curvatures.input, curvatures.result,
-                          report.dump(), html_report_options(o->input, o->output));
+        write_html_report(o->html_file, mesh, out, curvatures.input, curvatures.result, report.dump(),
+                          html_report_options(o->input, o->output));
         phase("HTML report written to " + o->html_file);
       }
     }

@@ -17,8 +17,8 @@
 // - Flipped faces need the same faces in both meshes (result.F == input.F, same vertex
 //   count); otherwise `flipped_faces` is empty ("not applicable"). Degenerate faces are
 //   counted on each mesh regardless.
-// - Curvature is estimated with principal_curvatures (curvature.h) on all three meshes, so
-//   every mesh must be manifold (CompareError otherwise).
+// - Curvature is estimated with principal_curvatures (curvature.h) on all three meshes; a
+//   non-manifold mesh is measured as it is (the estimator uses its manifold split).
 #pragma once
 
 #include "vertexflow/curvature.h"
@@ -41,7 +41,7 @@ enum class MeshRole { Result, Input, Reference };
 /// "result", "input" or "reference".
 const char* to_string(MeshRole role);
 
-/// Thrown by compare_meshes for a mesh it cannot measure (no faces, not manifold); what()
+/// Thrown by compare_meshes for a mesh it cannot measure (no faces, bad indices); what()
 /// describes the problem, role() says which mesh.
 class CompareError : public std::invalid_argument {
  public:
@@ -122,7 +122,7 @@ struct MeshComparison {
 };
 
 /// Measures `result` against `input` and, when not null, `reference`. Colours and vertex
-/// properties are ignored. Throws CompareError for a mesh without faces or a non-manifold one.
+/// properties are ignored. Throws CompareError for a mesh without faces.
 /// Parallel (TBB); the figures do not depend on the thread count.
 MeshComparison compare_meshes(const Mesh& result, const Mesh& input, const Mesh* reference,
                               const CompareOptions& options = {});
@@ -146,14 +146,14 @@ struct ComparePrecomputed {
 };
 
 /// The same with data the caller has computed already: the same figures, bit for bit. A given
-/// topology is checked as compare_meshes checks its own (CompareError for a mesh without faces
-/// or a non-manifold one); a topology or curvature for another vertex or face count throws
+/// topology is checked as compare_meshes checks its own (CompareError for a mesh without
+/// faces); a topology or curvature for another vertex or face count throws
 /// std::invalid_argument.
 MeshComparison compare_meshes(const Mesh& result, const Mesh& input, const Mesh* reference,
                               const CompareOptions& options, const ComparePrecomputed& precomputed);
 
 /// The topology of `mesh`, built and checked as compare_meshes does: CompareError naming
-/// `role` ("the result mesh has no faces", "the input mesh: the mesh is not manifold (...)")
+/// `role` ("the result mesh has no faces", or the reason build_topology refuses its faces)
 /// otherwise. For a caller that builds the topology itself, so that its errors read as the
 /// comparison's.
 Topology checked_topology(const Mesh& mesh, MeshRole role);

@@ -19,8 +19,10 @@
 //   (on hemisphere.off the boundary ring underestimates 1/R by a few percent; see
 //   tests/curvature). Vertices with no non-degenerate incident face get k1 = k2 = 0, the
 //   normal +z and an arbitrary frame. No NaN or inf is ever returned for finite input.
-// - Input: a manifold mesh (topology.h); principal_curvatures throws std::invalid_argument
-//   otherwise.
+// - Input: any triangle mesh. A non-manifold or inconsistently oriented one is estimated on its
+//   manifold split (manifold_split.h: faces oriented per component, non-manifold edges cut):
+//   a vertex whose faces form several fans takes the values of its largest fan's copy, and the
+//   area of all its fans. Normals then follow the orientation most faces of a component had.
 #pragma once
 
 #include "vertexflow/mesh.h"

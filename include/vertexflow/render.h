@@ -133,7 +133,7 @@ struct RenderInfo {
 };
 
 /// Renders `mesh` off-screen. Throws std::invalid_argument for bad options (size out of range,
-/// a displacement reference of the wrong size, curvature colouring on a non-manifold mesh) and
+/// a displacement reference of the wrong size) and
 /// std::runtime_error when OSMesa cannot create a context or the legend font cannot be loaded.
 /// Deterministic: the same mesh and options give the same pixels.
 Image render_mesh(const Mesh& mesh, const RenderOptions& options = {}, RenderInfo* info = nullptr);

@@ -11,6 +11,8 @@
 // helpers (Vec3, the SIMD clones), which would otherwise become an internal header of their own.
 #include "vertexflow/curvature.h"
 
+#include "vertexflow/manifold_split.h"
+
 #include "common/huge_pages.h"
 #include "numerics/parallel.h"
 
@@ -509,6 +511,45 @@ Eigen::VectorXd vertex_areas(const Vertices& V, const Faces& F) {
   return areas;
 }
 
+namespace {
+
+// A non-manifold or inconsistently oriented mesh (curvature.h): the estimator runs on the
+// manifold split (manifold_split.h); a vertex takes the values of its copy with the largest
+// area (the fan that holds most of its neighbourhood) and the area of all its copies, so the
+// areas still sum to the surface's.
+Curvature curvature_of_manifold_split(const Vertices& V, const Faces& F, const Topology& topology,
+                                      const CurvatureOptions& options) {
+  const ManifoldSplit split = split_non_manifold(V, F, topology);
+  const Curvature on_copies = principal_curvatures(split.V, split.F, build_topology(split.F, split.V.rows()), options);
+  const Index nv = static_cast<Index>(V.rows());
+  Curvature c;
+  c.k1.resize(nv);
+  c.k2.resize(nv);
+  c.T1.resize(nv, 3);
+  c.T2.resize(nv, 3);
+  c.N.resize(nv, 3);
+  c.area.resize(nv);
+  for (Index v = 0; v < nv; ++v) {
+    const Index first = split.first_copy[static_cast<std::size_t>(v)],
+                last = split.first_copy[static_cast<std::size_t>(v) + 1];
+    Index best = first;
+    double area = 0;
+    for (Index s = first; s < last; ++s) {
+      area += on_copies.area[s];
+      if (on_copies.area[s] > on_copies.area[best]) best = s;
+    }
+    c.k1[v] = on_copies.k1[best];
+    c.k2[v] = on_copies.k2[best];
+    c.T1.row(v) = on_copies.T1.row(best);
+    c.T2.row(v) = on_copies.T2.row(best);
+    c.N.row(v) = on_copies.N.row(best);
+    c.area[v] = area;
+  }
+  return c;
+}
+
+}  // namespace
+
 Curvature principal_curvatures(const Vertices& V, const Faces& F, const CurvatureOptions& options) {
   return principal_curvatures(V, F, build_topology(F, static_cast<Index>(V.rows())), options);
 }
@@ -519,7 +560,7 @@ Curvature principal_curvatures(const Vertices& V, const Faces& F, const Topology
   const Index nf = static_cast<Index>(F.rows());
   if (topology.num_vertices != nv || topology.num_faces != nf)
     throw std::invalid_argument("principal_curvatures: the topology was built for another mesh");
-  if (!topology.is_manifold()) throw std::invalid_argument(describe_non_manifold(topology));
+  if (!topology.is_manifold() || !topology.is_oriented) return curvature_of_manifold_split(V, F, topology, options);
   Curvature c;
   c.k1.resize(nv);
   c.k2.resize(nv);

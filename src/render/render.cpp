@@ -66,8 +66,6 @@ ScalarField scalar_field(const Mesh& mesh, const RenderOptions& options, const T
       return field;
     case RenderColor::Mean:
     case RenderColor::Gauss: {
-      if (!topology->is_manifold())
-        throw std::invalid_argument("cannot colour by curvature: " + describe_non_manifold(*topology));
       const Curvature c = principal_curvatures(mesh.V, mesh.F, *topology);
       const bool mean = options.color == RenderColor::Mean;
       field.values = mean ? c.mean() : c.gaussian();

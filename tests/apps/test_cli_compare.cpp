@@ -108,9 +108,8 @@ TEST(CliCompare, BadInputsAreOneLineErrors) {
   { std::ofstream(bowtie) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv -1 0 0\nv 0 -1 0\nf 1 2 3\nf 1 4 5\n"; }
   const auto nm = run_cli("--quiet compare " + quoted_data_path("sphere_low.off") + " " +
                           quoted_data_path("sphere_low.off") + " --reference " + shell_quote(bowtie.string()));
-  EXPECT_EQ(nm.exit_code, 1);
-  EXPECT_NE(nm.err.find("bowtie.obj: the reference mesh: the mesh is not manifold"), std::string::npos) << nm.err;
-  EXPECT_EQ(std::count(nm.err.begin(), nm.err.end(), '\n'), 1) << nm.err;
+  // A non-manifold reference is measured as it is (issue 15).
+  EXPECT_EQ(nm.exit_code, 0) << nm.err;
 
   EXPECT_NE(run_cli("compare " + quoted_data_path("sphere_low.off")).exit_code, 0);  // INPUT missing
   EXPECT_NE(run_cli("compare " + quoted_data_path("sphere_low.off") + " " + quoted_data_path("sphere_low.off") +

@@ -124,6 +124,46 @@ TEST(Curvature, SmoothingLowersTheErrorOfANoisySurface) {
   EXPECT_LT(smoothed, plain + 0.01);
 }
 
+// A non-manifold mesh (curvature.h): two spheres of radius R that share one vertex, and one of
+// them with a few faces reversed. Every vertex, the shared one included, gets about 1/R with an
+// outward normal, as on a sphere of its own.
+TEST(Curvature, NonManifoldAndMisorientedMeshesAreEstimatedPerFan) {
+  const double R = 2.0;
+  const Mesh sphere = test::icosphere(R, 3);
+  const Index n = sphere.num_vertices();
+  // The second sphere: translated by 2R along the direction of vertex 0, its antipode shared.
+  Index antipode = 0;
+  (sphere.V * sphere.V.row(0).transpose()).minCoeff(&antipode);
+  Mesh two;
+  two.V.resize(2 * n - 1, 3);
+  two.V.topRows(n) = sphere.V;
+  std::vector<Index> index(static_cast<std::size_t>(n));
+  const Eigen::RowVector3d shift = 2 * sphere.V.row(0);
+  for (Index v = 0, next = n; v < n; ++v) index[static_cast<std::size_t>(v)] = v == antipode ? 0 : next++;
+  for (Index v = 0; v < n; ++v)
+    if (v != antipode) two.V.row(index[static_cast<std::size_t>(v)]) = sphere.V.row(v) + shift;
+  two.F.resize(2 * sphere.num_faces(), 3);
+  two.F.topRows(sphere.num_faces()) = sphere.F;
+  for (Index f = 0; f < sphere.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k) two.F(sphere.num_faces() + f, k) = index[static_cast<std::size_t>(sphere.F(f, k))];
+  for (const Index f : {Index{5}, Index{77}, Index{300}}) std::swap(two.F(f, 1), two.F(f, 2));
+  const Topology topology = build_topology(two.F, two.num_vertices());
+  ASSERT_EQ(topology.non_manifold_vertices, std::vector<Index>{0});
+  ASSERT_FALSE(topology.is_oriented);
+  const Curvature c = principal_curvatures(two.V, two.F);
+  std::vector<double> errors;
+  for (Index v = 0; v < two.num_vertices(); ++v) {
+    errors.push_back(std::max(std::abs(c.k1[v] * R - 1), std::abs(c.k2[v] * R - 1)));
+    const Eigen::RowVector3d centre = v < n ? Eigen::RowVector3d::Zero() : shift;
+    if (v != 0) {
+      EXPECT_GT(c.N.row(v).dot(two.V.row(v) - centre), 0) << v;
+    }
+  }
+  EXPECT_LT(std::abs(c.k1[0] * R - 1), 0.05);  // the shared vertex: one fan's values
+  EXPECT_LE(percentile(errors, 50), 0.02);
+  EXPECT_NEAR(c.area.sum(), 2 * 4 * M_PI * R * R, 0.02 * 8 * M_PI * R * R);
+}
+
 TEST(Curvature, SphereIsUmbilicWithCurvatureOneOverR) {
   for (const double R : {0.5, 1.0, 20.0}) {
     const Mesh mesh = test::icosphere(R, 5);
