@@ -6,9 +6,10 @@
 // - Topology is computed for any triangle list, manifold or not, and reports what is wrong
 //   (non_manifold_edges, non_manifold_vertices, is_oriented). One-rings are in cyclic order
 //   only at manifold vertices.
-// - The flow runs on the manifold split of a non-manifold mesh (manifold_split.h), holding the
-//   vertices that are not discs. The other stages that need a manifold surface (curvature, the
-//   metrics) check `is_manifold()` and refuse non-manifold input with std::invalid_argument
+// - The flow and the curvature estimator (and so the metrics) run on the manifold split of a
+//   non-manifold mesh (manifold_split.h); the flow holds the vertices that are not discs. The
+//   stages that still need a manifold surface (the unsharp mask, remeshing and simplification)
+//   check `is_manifold()` and refuse non-manifold input with std::invalid_argument
 //   (describe_non_manifold: the counts and an offending vertex).
 #pragma once
 
