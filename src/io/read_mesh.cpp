@@ -37,7 +37,7 @@ void TextScanner::error(const std::string& message) const {
   const std::uint64_t line = 1 + (source_ ? source_->newlines_dropped() : 0) +
                              static_cast<std::uint64_t>(
                                  std::count(text_.begin(), text_.begin() + static_cast<std::ptrdiff_t>(end), '\n'));
-  fail(name_, fmt::format("line {}: {}", line, message));
+  fail(name_, fmt::format("line {}: {}", line - std::min(lines_back_, line - 1), message));
 }
 
 std::string TextScanner::printable(std::string_view tok) {

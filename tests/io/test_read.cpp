@@ -175,6 +175,70 @@ TEST(Cleanup, ObjIndexForms) {
   EXPECT_EQ(mesh.F.row(1), Eigen::RowVector3i(1, 3, 2));
 }
 
+// --- real-world forms: OBJ line continuation, OFF header on the keyword line, PLY extra values ---
+
+// The message of the IoError that reading `text` throws, or "" (plus a test failure).
+std::string read_error(const std::string& text, MeshFormat format) {
+  try {
+    read_mesh_from_memory(text, format, "memory");
+    ADD_FAILURE() << "accepted: " << text;
+  } catch (const IoError& e) {
+    return e.what();
+  }
+  return {};
+}
+
+const std::string kSquareVertices = "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\nv 2 1 0\n";
+
+TEST(ReadObj, ABackslashEndingALineContinuesTheStatement) {
+  // Two quads; each file splits the statements differently and must read as this one does.
+  const std::string plain = kSquareVertices + "f 1 2 3 4\nf 2 5 6 3\n";
+  ReadReport plain_report;
+  const Mesh expected = read_text(plain, MeshFormat::Obj, &plain_report);
+  ASSERT_EQ(expected.num_faces(), 4);
+  const std::string continued[] = {
+      kSquareVertices + "f 1 2 \\\n3 4\nf 2 5 6 3\n",                 // a backslash token
+      kSquareVertices + "f 1 2\\\n 3 4\nf 2 5 6 3\n",                 // attached to the index
+      kSquareVertices + "f 1/1/1 2/1/1\\\n3/1/1 4/1/1\nf 2 5 6 3\n",  // attached to a v/t/n corner
+      kSquareVertices + "f 1 2 \\ \t\r\n3 4\r\nf 2 5 6 3\r\n",        // blanks and CR after it
+      kSquareVertices + "f 1 \\\n\\\n  \\\n2 3 \\\n4\nf 2 5 6 3\n",   // lines holding only a backslash
+      kSquareVertices + "f 1 2 3 4 \\\n\nf 2 5 6 3\n",                // continued by an empty line
+      kSquareVertices + "f\\\n1 2 3 4\nf 2 5 6 3\n",                  // after the keyword
+      kSquareVertices + "f 1 2 3 4\nf 2 5 6 3 \\",                    // at the end of the file
+      "v 0 0 \\\n0\nv 1\\\n0 0\nv 1 1 0 \\\n1.0\nv \\\n0 1 0\n" + kSquareVertices.substr(32) +
+          "f 1 2 3 4\nf 2 5 6 3\n",  // vertices, one with a w continued
+      "vn 0 0 \\\n1\n" + kSquareVertices + "# a comment continues too \\\nf 9 9 9\nf 1 2 3 4\nf 2 5 6 3\n",
+  };
+  for (const std::string& text : continued) {
+    SCOPED_TRACE(text);
+    ReadReport report;
+    const Mesh mesh = read_text(text, MeshFormat::Obj, &report);
+    EXPECT_EQ(mesh.V, expected.V);
+    EXPECT_EQ(mesh.F, expected.F);
+    EXPECT_EQ(report.polygons_triangulated, 2);
+    EXPECT_EQ(report.warnings(), plain_report.warnings());  // the spec allows it: no warning
+  }
+}
+
+TEST(ReadObj, ContinuedStatementErrorsNameTheStatementsFirstLine) {
+  // The face starts on line 7 and its bad index is on line 9; the next statement's line
+  // numbers are the physical ones again.
+  EXPECT_EQ(read_error(kSquareVertices + "f 1 2 \\\n3 \\\nx\n", MeshFormat::Obj),
+            "memory: line 7: expected a face vertex index, found 'x'");
+  EXPECT_EQ(read_error(kSquareVertices + "f 1 2 \\\n3\nf 1 \\\n\\\nx\n", MeshFormat::Obj),
+            "memory: line 9: expected a face vertex index, found 'x'");
+  EXPECT_EQ(read_error("v 0 \\\n0\nv 1 0 0\n", MeshFormat::Obj), "memory: line 1: a vertex needs three coordinates");
+  // A backslash with more text after it on its line continues nothing.
+  EXPECT_EQ(read_error(kSquareVertices + "f 1 2 \\ 3\n", MeshFormat::Obj),
+            "memory: line 7: expected a face vertex index, found '\\'");
+  EXPECT_EQ(read_error(kSquareVertices + "f 1 2\\3\n", MeshFormat::Obj),
+            "memory: line 7: expected a face vertex index, found '2\\3'");
+  // Continued to the end of the file, the face has two vertices.
+  std::string endless = kSquareVertices + "f 1 2 \\\n";
+  for (int i = 0; i < 100000; ++i) endless += "\\\n";
+  EXPECT_EQ(read_error(endless, MeshFormat::Obj), "memory: face 0 has 2 vertices; a face needs at least 3");
+}
+
 // Sum of the triangles' areas projected on the polygon's normal, and of their absolute areas:
 // equal exactly when no triangle is folded over.
 std::pair<double, double> signed_and_absolute_area(const Mesh& mesh, const Eigen::Vector3d& normal) {

@@ -248,6 +248,14 @@ def make_obj():
     write("obj_vertex_two_coords.obj", obj(["v 0 0 0", "v 1 0", "v 0 1 0", "f 1 2 3"]))
     write("obj_face_two_vertices.obj", obj(OBJ_TRI + ["f 1 2"]))
     write("obj_no_faces.obj", obj(OBJ_TRI))
+    # Line continuation: errors name the statement's first line; a backslash with text after it
+    # on its line continues nothing; a face continued to the end of the file has two vertices.
+    write("obj_continued_face_garbage.obj", obj(OBJ_TRI + ["f 1 \\", "2 \\", "three"]))
+    write("obj_backslash_inside_line.obj", obj(OBJ_TRI + ["f 1 2 \\ 3"]))
+    write("obj_continued_to_the_end.obj", obj(OBJ_TRI + ["f 1 2 \\"] + ["\\"] * 1000))
+    # The same with 8 MB of continuation lines, about 8 kB compressed; the tests also read it
+    # with a 1 MiB inflation limit and expect the limit to stop it.
+    write("gz_obj_continued_line.obj.gz", gz(obj(OBJ_TRI + ["f 1 2 \\"]).encode() + b"\\\n" * (4 << 20)))
     write("obj_no_vertices.obj", obj(["# nothing but comments", "g group", "usemtl none"]))
     write("obj_all_degenerate.obj", obj(["v 0 0 0", "v 1 0 0", "v 2 0 0", "f 1 2 3"]))
 
