@@ -73,6 +73,9 @@ struct ReadReport {
   bool format_differs_from_extension = false;
   bool binary = false;
   bool gzip = false;
+  /// ASCII PLY lines with more values than their element declares (a writer bug): the
+  /// declared values are read, the extra ones ignored.
+  std::int64_t ply_extra_values_lines = 0;
   /// Polygons with more than three vertices that were triangulated.
   std::int64_t polygons_triangulated = 0;
   /// Polygons that could not be triangulated in their plane (self-intersecting or folded) and

@@ -156,6 +156,10 @@ def make_ply():
     write("ply_ascii_face_two_vertices.ply", ply_ascii(ply_header("ascii", 3, 1), TRI_BODY[:3] + ["2 0 1"]))
     write("ply_ascii_nan.ply", ply_ascii(ply_header("ascii", 3, 1), ["nan 0 0"] + TRI_BODY[1:]))
     write("ply_ascii_1e999.ply", ply_ascii(ply_header("ascii", 3, 1), ["0 0 0", "1e999 0 0"] + TRI_BODY[2:]))
+    # Extra values on a line are ignored with a warning, but they must be numbers; missing ones
+    # are an error on their line.
+    write("ply_ascii_extra_text.ply", ply_ascii(ply_header("ascii", 3, 1), ["0 0 0", "1 0 0 normal"] + TRI_BODY[2:]))
+    write("ply_ascii_face_too_few_indices.ply", ply_ascii(ply_header("ascii", 3, 1), TRI_BODY[:3] + ["4 0 1 2"]))
     write("ply_ascii_all_degenerate.ply", ply_ascii(ply_header("ascii", 3, 2), TRI_BODY[:3] + ["3 0 0 1", "3 2 2 2"]))
     header = ("\n".join(ply_header("binary_little_endian", 3, 1)) + "\n").encode()
     write("ply_le_inf.ply", header + struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, float("inf"), 0)
