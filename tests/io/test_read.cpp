@@ -239,6 +239,43 @@ TEST(ReadObj, ContinuedStatementErrorsNameTheStatementsFirstLine) {
   EXPECT_EQ(read_error(endless, MeshFormat::Obj), "memory: face 0 has 2 vertices; a face needs at least 3");
 }
 
+TEST(ReadOff, CountsMayFollowTheKeywordOnItsLine) {
+  // Each keyword the reader supports, with the counts on its line (with or without the edge
+  // count and a comment), or a comment on the keyword's line and the counts on the next.
+  const std::string vertices[] = {"0 0 0", "1 0 0", "1 1 0", "0 1 0"};
+  struct Case {
+    std::string keyword, extra;  // per-vertex values after x y z
+  };
+  const Case cases[] = {{"OFF", ""},           {"COFF", " 1 0 0 1"},
+                        {"NOFF", " 0 0 1"},    {"CNOFF", " 1 0 0 1 0 0 1"},
+                        {"STOFF", " 0.5 0.5"}, {"STCNOFF", " 0.5 0.5 1 0 0 1 0 0 1"}};
+  for (const Case& c : cases) {
+    std::string body;
+    for (const std::string& v : vertices) body += v + c.extra + "\n";
+    body += "4 0 1 2 3\n";
+    for (const std::string& header : {c.keyword + " 4 1 0\n", c.keyword + "\t4 1\n", c.keyword + " 4 1 0 # counts\n",
+                                      c.keyword + " # a comment\n4 1 0\n", c.keyword + "\n4 1 0\n"}) {
+      SCOPED_TRACE(header);
+      ReadReport report;
+      const Mesh mesh = read_text(header + body, MeshFormat::Off, &report);
+      EXPECT_EQ(mesh.num_vertices(), 4);
+      EXPECT_EQ(mesh.num_faces(), 2);
+      EXPECT_EQ(report.format, MeshFormat::Off);
+      EXPECT_FALSE(report.format_differs_from_extension);
+      EXPECT_EQ(report.warnings(), std::vector<std::string>{"1 polygons triangulated"});
+    }
+  }
+  // Errors stay errors: a keyword glued to a count, a count missing, a count the file cannot
+  // hold.
+  const std::string body = "0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n";
+  EXPECT_EQ(read_error("OFF3 1 0\n" + body, MeshFormat::Off),
+            "memory: not an OFF file (expected 'OFF' at the start, found 'OFF3')");
+  EXPECT_EQ(read_error("OFF 3 # no face count\n", MeshFormat::Off),
+            "memory: line 2: expected the face count, found ''");
+  const std::string huge = read_error("OFF 3 2000000000 0\n" + body, MeshFormat::Off);
+  EXPECT_EQ(huge.rfind("memory: header declares 3 vertices and 2000000000 faces, but the remaining", 0), 0u) << huge;
+}
+
 TEST(ReadPly, AsciiLinesWithMoreValuesThanDeclaredAreReadAndCounted) {
   const std::string header =
       "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
