@@ -103,6 +103,7 @@ nlohmann::json to_json(const MeshInfo& info) {
 
 nlohmann::json to_json(const ReadReport& report) {
   return {{"format", describe_format(report)},
+          {"ply_extra_values_lines", report.ply_extra_values_lines},
           {"polygons_triangulated", report.polygons_triangulated},
           {"polygons_fanned", report.polygons_fanned},
           {"vertices_welded", report.vertices_welded},

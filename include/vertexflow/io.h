@@ -11,6 +11,9 @@
 //   order or orientation) and zero-area faces (area < kDegenerateAreaRelative * diagonal^2) are
 //   removed, each counted in ReadReport;
 // - otherwise vertex order is kept, so per-vertex data in the file stays aligned.
+// Common real-world forms are read: OBJ lines continued with a trailing backslash, OFF counts
+// on the keyword's line, ASCII PLY lines with more values than declared (the extra ones are
+// ignored and counted in ReadReport).
 // A mesh whose bounding-box diagonal lies outside [1e-60, 1e60] is refused: squared areas
 // would overflow or underflow in double precision.
 //
@@ -73,6 +76,9 @@ struct ReadReport {
   bool format_differs_from_extension = false;
   bool binary = false;
   bool gzip = false;
+  /// ASCII PLY lines with more values than their element declares (a writer bug): the
+  /// declared values are read, the extra ones ignored.
+  std::int64_t ply_extra_values_lines = 0;
   /// Polygons with more than three vertices that were triangulated.
   std::int64_t polygons_triangulated = 0;
   /// Polygons that could not be triangulated in their plane (self-intersecting or folded) and

@@ -191,6 +191,31 @@ class TextScanner {
       if (!fill(pos_ + 1, pos_)) return;
     }
   }
+  /// Moves past the next '\n' (or to the end) and returns whether the line's last byte
+  /// other than blanks was a backslash: an OBJ line continuation.
+  bool skip_line_continued() {
+    char last = '\0';  // the last non-blank byte of the line seen so far
+    for (;;) {
+      const std::size_t nl = text_.find('\n', pos_);
+      // Backwards from the line's end (or the view's) over blanks: O(1) for a usual line.
+      for (std::size_t p = nl == std::string_view::npos ? text_.size() : nl; p > pos_; --p) {
+        const char c = text_[p - 1];
+        if (c != ' ' && c != '\t' && c != '\r') {
+          last = c;
+          break;
+        }
+      }
+      if (nl != std::string_view::npos) {
+        pos_ = nl + 1;
+        return last == '\\';
+      }
+      pos_ = std::max(pos_, text_.size());
+      if (!fill(pos_ + 1, pos_)) return last == '\\';
+    }
+  }
+  /// Makes error() report the line `lines` before the current one: the first physical line
+  /// of a statement continued over `lines` line breaks (OBJ).
+  void report_lines_back(std::uint64_t lines) { lines_back_ = lines; }
   bool at_line_end() { return !has() || text_[pos_] == '\n' || text_[pos_] == '#'; }
   /// The next whitespace-delimited token on the current line (empty at the line's end).
   std::string_view token_on_line() {
@@ -278,6 +303,7 @@ class TextScanner {
   std::size_t base_ = 0;  // position of text_[0] in the content
   const std::string& name_;
   std::size_t pos_ = 0;  // index into text_
+  std::uint64_t lines_back_ = 0;
 };
 
 }  // namespace vertexflow::io_detail

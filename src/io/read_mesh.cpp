@@ -37,7 +37,7 @@ void TextScanner::error(const std::string& message) const {
   const std::uint64_t line = 1 + (source_ ? source_->newlines_dropped() : 0) +
                              static_cast<std::uint64_t>(
                                  std::count(text_.begin(), text_.begin() + static_cast<std::ptrdiff_t>(end), '\n'));
-  fail(name_, fmt::format("line {}: {}", line, message));
+  fail(name_, fmt::format("line {}: {}", line - std::min(lines_back_, line - 1), message));
 }
 
 std::string TextScanner::printable(std::string_view tok) {
@@ -390,6 +390,7 @@ std::vector<std::string> ReadReport::warnings() const {
   if (format_differs_from_extension)
     out.push_back(fmt::format("the file's content is {}, not what its extension says; read as {}",
                               format_name(format), format_name(format)));
+  add(ply_extra_values_lines, "lines had more values than their element declares; the extra values were ignored");
   add(polygons_triangulated, "polygons triangulated");
   add(polygons_fanned, "polygons had no planar triangulation (self-intersecting or folded) and were fanned");
   add(vertices_welded, "duplicate vertices welded");

@@ -252,7 +252,7 @@ class PlyParser {
   }
   // ASCII body scanning shares body_ through a scanner positioned at it.
   // ASCII PLY has one element record per line: values are taken from the current line only,
-  // and begin_record/end_record check that a record neither spills over nor leaves values.
+  // so a missing value is an error on its line instead of shifting every later value.
   double ascii_value(const char* what) {
     const std::string_view tok = ascii().token_on_line();
     if (tok.empty()) ascii().error(fmt::format("too few values on the line (expected {})", what));
@@ -264,8 +264,21 @@ class PlyParser {
   void end_record(const Element& element) {
     if (encoding_ != Encoding::Ascii) return;
     ascii().skip_blanks();
-    if (!ascii().at_end() && ascii().peek() != '\n')
-      ascii().error(fmt::format("more values than the '{}' element declares", element.name));
+    if (ascii().at_end() || ascii().peek() == '\n') return;
+    // More values than declared is a common writer bug (e.g. normals or a face colour written
+    // but not declared). The declared values were read from the line's start, so they are
+    // right; the rest is ignored, and counted. It must still be numbers: anything else is no
+    // PLY record.
+    for (std::string_view tok = ascii().token_on_line(); !tok.empty(); tok = ascii().token_on_line()) {
+      const std::string_view number = tok.substr(tok.front() == '+' ? 1 : 0);  // as to_double reads it
+      double value = 0;
+      const auto [ptr, ec] = std::from_chars(number.data(), number.data() + number.size(), value);
+      if (number.empty() || ptr != number.data() + number.size() ||
+          (ec != std::errc() && ec != std::errc::result_out_of_range))
+        ascii().error(fmt::format("more values than the '{}' element declares, and '{}' is not a number", element.name,
+                                  TextScanner::printable(tok)));
+    }
+    ++report_.ply_extra_values_lines;
   }
   TextScanner& ascii() {
     if (!scanner_) {

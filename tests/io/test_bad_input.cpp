@@ -65,6 +65,7 @@ const std::map<std::string, std::string> kExpected = {
     {"gz_bad_crc.ply.gz", "invalid gzip data (incorrect data check)"},
     {"gz_huge_face_count.ply.gz", "header declares 2000000000 'face' elements"},
     {"gz_bomb.ply.gz", "PLY header has no end_header line"},
+    {"gz_obj_continued_line.obj.gz", "face 0 has 2 vertices; a face needs at least 3"},
     // PLY: truncation.
     {"ply_le_truncated_in_vertices.ply", "header declares 8 'vertex' elements, but the remaining 60 bytes"},
     {"ply_be_truncated_in_vertices.ply", "header declares 8 'vertex' elements, but the remaining 60 bytes"},
@@ -110,6 +111,9 @@ const std::map<std::string, std::string> kExpected = {
     {"ply_ascii_nan.ply", "vertex 0 has a non-finite coordinate (nan)"},
     {"ply_ascii_1e999.ply", "line 11: number '1e999' is out of range"},
     {"ply_ascii_all_degenerate.ply", "no valid faces remain"},
+    {"ply_ascii_extra_text.ply",
+     "line 11: more values than the 'vertex' element declares, and 'normal' is not a number"},
+    {"ply_ascii_face_too_few_indices.ply", "line 13: too few values on the line (expected a face vertex index)"},
     {"ply_le_inf.ply", "vertex 2 has a non-finite coordinate (inf)"},
     {"ply_le_negative_index.ply", "face 0 has invalid vertex index -1"},
     {"ply_le_uint_index_too_large.ply", "face 0 has invalid vertex index 4294967295"},
@@ -153,6 +157,9 @@ const std::map<std::string, std::string> kExpected = {
     {"obj_no_faces.obj", "the file contains no faces"},
     {"obj_no_vertices.obj", "the file contains no vertices"},
     {"obj_all_degenerate.obj", "no valid faces remain"},
+    {"obj_continued_face_garbage.obj", "line 5: expected a face vertex index, found 'three'"},
+    {"obj_backslash_inside_line.obj", "line 5: expected a face vertex index, found '\\'"},
+    {"obj_continued_to_the_end.obj", "face 0 has 2 vertices; a face needs at least 3"},
     // STL.
     {"stl_binary_count_lies.stl", "binary STL header declares 1000000 triangles (50000084 bytes), but the file has 184 bytes"},
     {"stl_binary_count_max.stl", "binary STL header declares 4294967295 triangles"},
@@ -384,6 +391,15 @@ TEST(BadInput, GzipBombStopsAtTheInflationLimit) {
   ReadOptions options;
   options.inflate_floor_bytes = 1 << 20;  // 8 MB of newlines from 8 kB: past 1 MiB, and past 32x
   const fs::path p = test_data_path("bad/gz_bomb.ply.gz");
+  expect_message(read_error(p, options), p.string(), "gzip data inflates to more than 1048576 bytes");
+}
+
+// A statement continued over 8 MB of lines: the joined statement is never held in memory, and
+// the inflation limit bounds it as it bounds any other content.
+TEST(BadInput, AnEndlessContinuedObjLineStopsAtTheInflationLimit) {
+  ReadOptions options;
+  options.inflate_floor_bytes = 1 << 20;
+  const fs::path p = test_data_path("bad/gz_obj_continued_line.obj.gz");
   expect_message(read_error(p, options), p.string(), "gzip data inflates to more than 1048576 bytes");
 }
 

@@ -118,6 +118,20 @@ TEST(GzipBomb, AGigabyteAfterAValidMeshIsStillABomb) {
   expect_one_line_error(run, bomb, "gzip data inflates to more than");
 }
 
+TEST(GzipBomb, AnEndlessContinuedObjLineStopsAtTheLimit) {
+  const ScratchDir scratch("bomb-continued");
+  const fs::path bomb = scratch.file("continued.obj.gz");
+  // One `f` statement continued over a gigabyte of lines: joined as it is read, never held.
+  const std::string continuations = gzip_member([] {
+    std::string lines;
+    for (std::size_t i = 0; i < (std::size_t{16} << 20) / 2; ++i) lines += "\\\n";
+    return lines;
+  }());
+  write_file(bomb, gzip_member("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3 \\\n"), continuations, 64);  // 1 GiB
+  const auto run = test::run_cli_watched({"info", bomb.string()}, kWatchdogSeconds);
+  expect_one_line_error(run, bomb, "gzip data inflates to more than 67108864 bytes");
+}
+
 // --- streaming -------------------------------------------------------------------------------
 
 // An OBJ text of `n` vertex lines of varied length and faces over them.
@@ -169,6 +183,26 @@ TEST(GzipStream, LineNumbersCountTheDroppedBytes) {
   const auto lines = std::count(text.begin(), text.end(), '\n');
   text += "v 1 2 x\n";
   const std::string expected = "line " + std::to_string(lines + 1) + ": expected a vertex coordinate, found 'x'";
+  for (const bool gzip : {false, true}) {
+    SCOPED_TRACE(gzip ? "gzip" : "plain");
+    try {
+      read_mesh_from_memory(gzip ? gzip_member(text, 1) : text, MeshFormat::Obj, "bad.obj");
+      ADD_FAILURE() << "accepted";
+    } catch (const IoError& e) {
+      EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+    }
+  }
+}
+
+TEST(GzipStream, AContinuedStatementsErrorNamesItsFirstLineAfterDroppedBytes) {
+  // The statement starts far into the stream and spans more lines than a window holds, so
+  // both its first line and the bad index's line lie in dropped bytes.
+  std::string text = obj_text(400'000);
+  const auto lines = std::count(text.begin(), text.end(), '\n');
+  text += "f 1 2 \\\n";
+  for (int i = 0; i < 1'000'000; ++i) text += "3 \\\n";
+  text += "x\n";
+  const std::string expected = "line " + std::to_string(lines + 1) + ": expected a face vertex index, found 'x'";
   for (const bool gzip : {false, true}) {
     SCOPED_TRACE(gzip ? "gzip" : "plain");
     try {

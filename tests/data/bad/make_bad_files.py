@@ -156,6 +156,10 @@ def make_ply():
     write("ply_ascii_face_two_vertices.ply", ply_ascii(ply_header("ascii", 3, 1), TRI_BODY[:3] + ["2 0 1"]))
     write("ply_ascii_nan.ply", ply_ascii(ply_header("ascii", 3, 1), ["nan 0 0"] + TRI_BODY[1:]))
     write("ply_ascii_1e999.ply", ply_ascii(ply_header("ascii", 3, 1), ["0 0 0", "1e999 0 0"] + TRI_BODY[2:]))
+    # Extra values on a line are ignored with a warning, but they must be numbers; missing ones
+    # are an error on their line.
+    write("ply_ascii_extra_text.ply", ply_ascii(ply_header("ascii", 3, 1), ["0 0 0", "1 0 0 normal"] + TRI_BODY[2:]))
+    write("ply_ascii_face_too_few_indices.ply", ply_ascii(ply_header("ascii", 3, 1), TRI_BODY[:3] + ["4 0 1 2"]))
     write("ply_ascii_all_degenerate.ply", ply_ascii(ply_header("ascii", 3, 2), TRI_BODY[:3] + ["3 0 0 1", "3 2 2 2"]))
     header = ("\n".join(ply_header("binary_little_endian", 3, 1)) + "\n").encode()
     write("ply_le_inf.ply", header + struct.pack("<9f", 0, 0, 0, 1, 0, 0, 0, float("inf"), 0)
@@ -248,6 +252,14 @@ def make_obj():
     write("obj_vertex_two_coords.obj", obj(["v 0 0 0", "v 1 0", "v 0 1 0", "f 1 2 3"]))
     write("obj_face_two_vertices.obj", obj(OBJ_TRI + ["f 1 2"]))
     write("obj_no_faces.obj", obj(OBJ_TRI))
+    # Line continuation: errors name the statement's first line; a backslash with text after it
+    # on its line continues nothing; a face continued to the end of the file has two vertices.
+    write("obj_continued_face_garbage.obj", obj(OBJ_TRI + ["f 1 \\", "2 \\", "three"]))
+    write("obj_backslash_inside_line.obj", obj(OBJ_TRI + ["f 1 2 \\ 3"]))
+    write("obj_continued_to_the_end.obj", obj(OBJ_TRI + ["f 1 2 \\"] + ["\\"] * 1000))
+    # The same with 8 MB of continuation lines, about 8 kB compressed; the tests also read it
+    # with a 1 MiB inflation limit and expect the limit to stop it.
+    write("gz_obj_continued_line.obj.gz", gz(obj(OBJ_TRI + ["f 1 2 \\"]).encode() + b"\\\n" * (4 << 20)))
     write("obj_no_vertices.obj", obj(["# nothing but comments", "g group", "usemtl none"]))
     write("obj_all_degenerate.obj", obj(["v 0 0 0", "v 1 0 0", "v 2 0 0", "f 1 2 3"]))
 
