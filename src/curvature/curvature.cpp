@@ -522,12 +522,8 @@ Curvature curvature_of_manifold_split(const Vertices& V, const Faces& F, const T
   const ManifoldSplit split = split_non_manifold(V, F, topology);
   const Curvature on_copies = principal_curvatures(split.V, split.F, build_topology(split.F, split.V.rows()), options);
   const Index nv = static_cast<Index>(V.rows());
+  std::vector<Index> largest(static_cast<std::size_t>(nv));
   Curvature c;
-  c.k1.resize(nv);
-  c.k2.resize(nv);
-  c.T1.resize(nv, 3);
-  c.T2.resize(nv, 3);
-  c.N.resize(nv, 3);
   c.area.resize(nv);
   for (Index v = 0; v < nv; ++v) {
     const Index first = split.first_copy[static_cast<std::size_t>(v)],
@@ -538,13 +534,14 @@ Curvature curvature_of_manifold_split(const Vertices& V, const Faces& F, const T
       area += on_copies.area[s];
       if (on_copies.area[s] > on_copies.area[best]) best = s;
     }
-    c.k1[v] = on_copies.k1[best];
-    c.k2[v] = on_copies.k2[best];
-    c.T1.row(v) = on_copies.T1.row(best);
-    c.T2.row(v) = on_copies.T2.row(best);
-    c.N.row(v) = on_copies.N.row(best);
+    largest[static_cast<std::size_t>(v)] = best;
     c.area[v] = area;
   }
+  c.k1 = on_copies.k1(largest);
+  c.k2 = on_copies.k2(largest);
+  c.T1 = on_copies.T1(largest, Eigen::all);
+  c.T2 = on_copies.T2(largest, Eigen::all);
+  c.N = on_copies.N(largest, Eigen::all);
   return c;
 }
 
