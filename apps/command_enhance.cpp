@@ -204,7 +204,13 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str();
   command
       ->add_option("--min-quality", o->flow.min_quality,
-                   "Guard: no face ends below min(this, its input radius ratio 2r/R); 0 repairs only flips")
+                   "Guard: no face ends below min(this, the worst input radius ratio 2r/R around its corners); "
+                   "0 repairs only flips")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  command
+      ->add_option("--sliver-floor", o->flow.sliver_floor,
+                   "Guard: a face starting below --min-quality may not fall below this fraction of its input ratio")
       ->check(CLI::Range(0.0, 1.0))
       ->capture_default_str();
   command->add_flag("--no-projection", o->no_projection,

@@ -104,12 +104,26 @@ struct FlowOptions {
   bool refuse_non_manifold = false;
   /// Halvings of a vertex's displacement before it is set to zero by the guard.
   int max_halvings = 30;
-  /// The guard also treats as bad a face whose radius ratio 2r/R (quality.h) falls below
-  /// min(min_quality, the same face's input quality): no face ends below 0.3 unless it started
-  /// there, and none gets worse than it started. The solve itself has no quality term; without
-  /// this, CAD creases produced 0.3% (fandisk) to 3% (spot) of faces below 0.3. 0 disables it
-  /// (only flipped and degenerate faces are repaired).
+  /// The guard repairs every flipped or degenerate face, and every face whose radius ratio 2r/R
+  /// (quality.h) ends below its floor:
+  ///
+  ///     floor(f) = min(min_quality, worst input quality of the faces around f's corners)
+  ///                and, if f starts below min_quality, at most sliver_floor * f's input quality.
+  ///
+  /// So a face that starts at or above min_quality ends at or above it unless a worse face
+  /// touches it; the worst face around a vertex never ends below min(min_quality, the worst
+  /// input face around it), except that slivers (faces starting below min_quality) may lose
+  /// up to the fraction 1 - sliver_floor of their quality. A face may thus get worse than it
+  /// started as long as the worst face it touches does not: the earlier rule (no face below
+  /// its own input quality) froze sliver-heavy meshes (a thin genus-121 plate with 75% of its
+  /// faces below 0.3: 89% of the vertices shortened, rho +0.00; now rho +0.30). The solve
+  /// itself has no quality term; without the floor, CAD creases produced 0.3% (fandisk) to 3%
+  /// (spot) of faces below 0.3. 0 disables it (only flipped and degenerate faces are repaired).
   double min_quality = 0.3;
+  /// See min_quality: the fraction of its input quality below which a sliver (a face that
+  /// starts below min_quality) may not fall. 1 keeps every sliver at least as good as its
+  /// worst neighbour at the input; 0 lets slivers go down to any positive area.
+  double sliver_floor = 0.5;
   CurvatureOptions curvature;
   /// Solver of the linear system; the choice does not change the energy that is minimised.
   LinearSolver solver = LinearSolver::Automatic;
@@ -129,7 +143,7 @@ struct FlowReport {
   /// The guard runs after every solve (options.iterations); these sum over the solves.
   Index flipped_before_guard = 0;      ///< faces the unguarded solution turned or degenerated
   Index low_quality_before_guard = 0;  ///< faces it left below their quality floor
-  Index limited_vertices = 0;          ///< vertices whose displacement the guard shortened (any solve)
+  Index limited_vertices = 0;          ///< vertices the guard left short of their proposed move (any solve)
   Index fixed_vertices = 0;            ///< boundary, pinned, isolated and corner vertices
   /// Non-manifold input (manifold_split.h), all 0 for a manifold, oriented mesh:
   Index held_non_manifold_vertices = 0;  ///< vertices held because their faces form more than one fan
@@ -149,7 +163,7 @@ struct FlowResult {
 
 /// Checks every option against its allowed range: lambda > 0, mu >= 0, epsilon > 0 (all
 /// finite), d_percentile in [0, 100], iterations >= 1, feature_angle >= 0, max_halvings >= 1,
-/// min_quality in [0, 1], solver_tolerance in (0, 1), curvature.smoothing_rounds >= 0, and
+/// min_quality and sliver_floor in [0, 1], solver_tolerance in (0, 1), curvature.smoothing_rounds >= 0, and
 /// (when num_vertices >= 0) every pinned index in [0, num_vertices). Throws
 /// std::invalid_argument naming the first option out of range and its allowed range.
 void validate_flow_options(const FlowOptions& options, Index num_vertices = -1);

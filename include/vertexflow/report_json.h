@@ -39,7 +39,7 @@ void to_json(nlohmann::json& j, const CurvatureOptions& options);
 
 /// One flat object: the weights' keys (to_json of EnergyWeights) beside d_percentile,
 /// iterations, project_to_input, feature_angle, fix_boundary, pinned (the count of pinned
-/// vertices), max_halvings, min_quality, curvature (an object), solver and solver_tolerance.
+/// vertices), max_halvings, min_quality, sliver_floor, curvature (an object), solver and solver_tolerance.
 /// The weights are not nested so that the report keeps the keys it had before FlowOptions held
 /// them as a struct (options.lambda, options.mu, ...).
 void to_json(nlohmann::json& j, const FlowOptions& options);

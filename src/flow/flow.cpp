@@ -31,6 +31,7 @@ void validate_flow_options(const FlowOptions& o, Index num_vertices) {
   require(o.feature_angle >= 0, "feature_angle must be >= 0 degrees (180 or more disables creases)");
   require(o.max_halvings >= 1, "max_halvings must be at least 1");
   require(o.min_quality >= 0 && o.min_quality <= 1, "min_quality must be in [0, 1]");
+  require(o.sliver_floor >= 0 && o.sliver_floor <= 1, "sliver_floor must be in [0, 1]");
   require(o.solver_tolerance > 0 && o.solver_tolerance < 1, "solver_tolerance must be in (0, 1)");
   require(o.curvature.smoothing_rounds >= 0, "curvature.smoothing_rounds must be >= 0");
   if (num_vertices < 0) return;
@@ -113,7 +114,7 @@ FlowResult vertex_flow(const Vertices& V, const Faces& F, const Topology& topolo
   Vertices X = input;
   // One solver for all rounds: the connectivity is fixed, so its ordering is computed once.
   FlowSystemSolver solver(topology, fixed, options.solver, options.solver_tolerance);
-  const GuardCriteria criteria = guard_criteria(input, F, options.min_quality);
+  const GuardCriteria criteria = guard_criteria(input, F, options.min_quality, options.sliver_floor);
   std::vector<char> shortened(static_cast<std::size_t>(n), 0);
   for (int round = 0; round < options.iterations; ++round) {
     const Vertices start_of_round = X;

@@ -63,6 +63,7 @@ void to_json(nlohmann::json& j, const FlowOptions& options) {
             {"refuse_non_manifold", options.refuse_non_manifold},
             {"max_halvings", options.max_halvings},
             {"min_quality", options.min_quality},
+            {"sliver_floor", options.sliver_floor},
             {"curvature", options.curvature},
             {"solver", options.solver},
             {"solver_tolerance", options.solver_tolerance}});

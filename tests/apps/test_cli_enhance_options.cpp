@@ -85,20 +85,44 @@ TEST(CliEnhanceOptions, IterationsRepeatTheSolve) {
 }
 
 TEST(CliEnhanceOptions, MinQualityIsTheGuardsFloor) {
-  // spot: at the default floor 0.3 some faces end between 0.3 and 0.5 although they started
-  // above 0.5; at --min-quality 0.5 none does.
+  // spot: at the default floor 0.3 some faces end below the floor that 0.5 would set
+  // (FlowOptions::min_quality); at --min-quality 0.5 none does.
   const Mesh mesh = read_mesh(test::data_path("spot.obj"));
-  const Eigen::VectorXd q_in = triangle_quality(mesh.V, mesh.F);
-  auto below_floor = [&](const Vertices& X, double floor) {
+  auto below_floor = [&](const Vertices& X, double min_quality) {
+    const Eigen::VectorXd floor = test::stated_quality_floor(mesh, min_quality, FlowOptions{}.sliver_floor);
     const Eigen::VectorXd q = triangle_quality(X, mesh.F);
     Index count = 0;
-    for (Index f = 0; f < mesh.num_faces(); ++f) count += q[f] < std::min(floor, q_in[f]) - 1e-12 ? 1 : 0;
+    for (Index f = 0; f < mesh.num_faces(); ++f) count += q[f] < floor[f] - 1e-12 ? 1 : 0;
     return count;
   };
   EXPECT_GT(below_floor(vertex_flow(mesh.V, mesh.F).V, 0.5), 0);
   const FlowResult r =
       expect_reaches_the_library(mesh, "spot.obj", "--min-quality 0.5", [](FlowOptions& o) { o.min_quality = 0.5; });
   EXPECT_EQ(below_floor(r.V, 0.5), 0);
+}
+
+TEST(CliEnhanceOptions, SliverFloorBoundsHowFarSliversMayFall) {
+  // camelhead: 1987 faces below their floor before the guard at the defaults, most of them
+  // slivers. A lower sliver floor lets the flow move further, a floor of 1 less; each result
+  // keeps the floor it was given.
+  const Mesh mesh = read_mesh(test::data_path("camelhead.off"));
+  const double moved_default = mean_displacement(mesh, vertex_flow(mesh.V, mesh.F).V);
+  for (const double sliver_floor : {0.0, 1.0}) {
+    const FlowResult r =
+        expect_reaches_the_library(mesh, "camelhead.off", "--sliver-floor " + std::to_string(sliver_floor),
+                                   [&](FlowOptions& o) { o.sliver_floor = sliver_floor; });
+    const Eigen::VectorXd floor = test::stated_quality_floor(mesh, 0.3, sliver_floor);
+    const Eigen::VectorXd q = triangle_quality(r.V, mesh.F);
+    for (Index f = 0; f < mesh.num_faces(); ++f) ASSERT_GE(q[f], floor[f] - 1e-12) << sliver_floor << ", face " << f;
+    const double moved = mean_displacement(mesh, r.V);
+    std::cout << "[measured] camelhead --sliver-floor " << sliver_floor << ": mean displacement " << moved
+              << " (default " << moved_default << ")\n";
+    if (sliver_floor == 0.0) {
+      EXPECT_GT(moved, moved_default);
+    } else {
+      EXPECT_LT(moved, moved_default);
+    }
+  }
 }
 
 TEST(CliEnhanceOptions, NoProjectionLeavesTheSurface) {

@@ -63,7 +63,7 @@ TEST(ReportJson, CurvatureOptionsEveryField) {
 TEST(ReportJson, FlowOptionsEveryField) {
   FlowOptions options;
   auto& [weights, d_percentile, iterations, project_to_input, feature_angle, fix_boundary, pinned, refuse_non_manifold,
-         max_halvings, min_quality, curvature, solver, solver_tolerance] = options;
+         max_halvings, min_quality, sliver_floor, curvature, solver, solver_tolerance] = options;
   weights.lambda = 0.25;
   weights.mu = 0.75;
   weights.epsilon = 1e-4;
@@ -77,6 +77,7 @@ TEST(ReportJson, FlowOptionsEveryField) {
   refuse_non_manifold = true;
   max_halvings = 12;
   min_quality = 0.2;
+  sliver_floor = 0.25;
   curvature.normal_weighting = NormalWeighting::Area;
   curvature.smoothing_rounds = 1;
   solver = LinearSolver::Multilevel;
@@ -87,6 +88,7 @@ TEST(ReportJson, FlowOptionsEveryField) {
     "lambda": 0.25, "mu": 0.75, "epsilon": 1e-4, "fairness_target": "zero",
     "d_percentile": 95.0, "iterations": 3, "project_to_input": false, "feature_angle": 30.0,
     "fix_boundary": false, "pinned": 3, "refuse_non_manifold": true, "max_halvings": 12, "min_quality": 0.2,
+    "sliver_floor": 0.25,
     "curvature": {"normal_weighting": "area", "smoothing_rounds": 1},
     "solver": "conjugate gradients, multilevel", "solver_tolerance": 1e-9})"));
   expect_every_value_differs(j, FlowOptions{});

@@ -176,26 +176,28 @@ Mesh bowtie() {
   return mesh;
 }
 
-Mesh perforated_plate(int holes, int subdivisions, double thickness, bool bottom) {
-  const int cells = 2 * holes + 1, n = cells * subdivisions;  // lattice of (n + 1)^2 points
+namespace {
+
+// perforated_plate with each cell cut into sx x sy quads (x by y).
+Mesh perforated_plate_lattice(int holes, int sx, int sy, double thickness, bool bottom) {
+  const int cells = 2 * holes + 1, nx = cells * sx, ny = cells * sy;  // (nx + 1) x (ny + 1) points
   std::vector<Eigen::Vector3d> p;
   for (int layer = 0; layer < 2; ++layer) {  // 0: bottom (z = 0), 1: top (z = thickness)
-    for (int i = 0; i <= n; ++i) {
-      for (int j = 0; j <= n; ++j)
-        p.emplace_back(double(i) / subdivisions, double(j) / subdivisions, layer * thickness);
+    for (int i = 0; i <= nx; ++i) {
+      for (int j = 0; j <= ny; ++j) p.emplace_back(double(i) / sx, double(j) / sy, layer * thickness);
     }
   }
-  auto index = [&](int layer, int i, int j) { return layer * (n + 1) * (n + 1) + i * (n + 1) + j; };
+  auto index = [&](int layer, int i, int j) { return layer * (nx + 1) * (ny + 1) + i * (ny + 1) + j; };
   auto solid = [&](int i, int j) {  // sub-quad (i, j) of the lattice is material
-    return i >= 0 && j >= 0 && i < n && j < n && !((i / subdivisions) % 2 == 1 && (j / subdivisions) % 2 == 1);
+    return i >= 0 && j >= 0 && i < nx && j < ny && !((i / sx) % 2 == 1 && (j / sy) % 2 == 1);
   };
   std::vector<Eigen::Vector3i> f;
   auto quad = [&](int a, int b, int c, int d) {  // counter-clockwise seen from outside
     f.emplace_back(a, b, c);
     f.emplace_back(a, c, d);
   };
-  for (int i = 0; i < n; ++i) {
-    for (int j = 0; j < n; ++j) {
+  for (int i = 0; i < nx; ++i) {
+    for (int j = 0; j < ny; ++j) {
       if (!solid(i, j)) continue;
       quad(index(1, i, j), index(1, i + 1, j), index(1, i + 1, j + 1), index(1, i, j + 1));
       if (bottom) quad(index(0, i, j), index(0, i, j + 1), index(0, i + 1, j + 1), index(0, i + 1, j));
@@ -227,6 +229,25 @@ Mesh perforated_plate(int holes, int subdivisions, double thickness, bool bottom
     for (int k = 0; k < 3; ++k) t[k] = remap[static_cast<std::size_t>(t[k])];
   }
   return from_lists(used, f);
+}
+
+}  // namespace
+
+Mesh perforated_plate(int holes, int subdivisions, double thickness, bool bottom) {
+  return perforated_plate_lattice(holes, subdivisions, subdivisions, thickness, bottom);
+}
+
+Mesh sliver_plate(int holes, int slivers, double thickness, double jitter, unsigned seed) {
+  Mesh plate = perforated_plate_lattice(holes, slivers, 1, thickness, true);
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> uniform(-jitter / slivers, jitter / slivers);
+  for (Index v = 0; v < plate.num_vertices(); ++v) {
+    const double x = plate.V(v, 0) * slivers;
+    const bool on_cell_line = std::lround(x) % slivers == 0 && std::abs(x - std::round(x)) < 1e-9;
+    const double shift = uniform(random);  // drawn for every vertex: the same stream for any jitter
+    if (!on_cell_line) plate.V(v, 0) += shift;
+  }
+  return plate;
 }
 
 Mesh noisy_scan(const Mesh& mesh, double normal_noise, double tangential_jitter, unsigned seed) {

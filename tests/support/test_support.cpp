@@ -1,5 +1,6 @@
 #include "test_support.h"
 
+#include "vertexflow/quality.h"
 #include "vertexflow/topology.h"
 
 #include <gtest/gtest.h>
@@ -9,15 +10,15 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
 #include <chrono>
 #include <csignal>
-#include <thread>
-#include <cctype>
 #include <cstdio>
 #include <fstream>
 #include <random>
 #include <sstream>
+#include <thread>
 
 namespace vertexflow::test {
 
@@ -127,6 +128,21 @@ WatchedRun run_cli_watched(const std::vector<std::string>& arguments, double tim
   result.peak_rss_kb = usage.ru_maxrss;
   result.err = read_text(err_path);
   return result;
+}
+
+Eigen::VectorXd stated_quality_floor(const Mesh& input, double min_quality, double sliver_floor) {
+  const Eigen::VectorXd q = triangle_quality(input.V, input.F);
+  const Topology topology = build_topology(input.F, input.num_vertices());
+  Eigen::VectorXd floor(input.num_faces());
+  for (Index f = 0; f < input.num_faces(); ++f) {
+    floor[f] = q[f] < min_quality ? std::min(min_quality, sliver_floor * q[f]) : min_quality;
+    for (int k = 0; k < 3; ++k) {
+      const auto v = static_cast<std::size_t>(input.F(f, k));
+      for (Index j = topology.face_offsets[v]; j < topology.face_offsets[v + 1]; ++j)
+        floor[f] = std::min(floor[f], q[topology.vertex_faces[static_cast<std::size_t>(j)]]);
+    }
+  }
+  return floor;
 }
 
 void expect_same_topology(const Mesh& input, const Mesh& output) {

@@ -60,10 +60,10 @@ CommandResult run_cli(const std::string& arguments);
 
 /// What run_cli_watched saw of one run.
 struct WatchedRun {
-  int exit_code = -1;         ///< exit status, or -1 if the process died from a signal
-  bool timed_out = false;     ///< killed by the watchdog
-  std::string err;            ///< stderr
-  long peak_rss_kb = 0;       ///< the child's peak resident set (getrusage ru_maxrss)
+  int exit_code = -1;      ///< exit status, or -1 if the process died from a signal
+  bool timed_out = false;  ///< killed by the watchdog
+  std::string err;         ///< stderr
+  long peak_rss_kb = 0;    ///< the child's peak resident set (getrusage ru_maxrss)
 };
 
 /// Runs the CLI with `arguments` (not through a shell) and `environment` entries
@@ -76,7 +76,9 @@ WatchedRun run_cli_watched(const std::vector<std::string>& arguments, double tim
 std::string shell_quote(const std::string& s);
 
 /// A path single-quoted for /bin/sh.
-inline std::string quoted(const std::filesystem::path& path) { return shell_quote(path.string()); }
+inline std::string quoted(const std::filesystem::path& path) {
+  return shell_quote(path.string());
+}
 
 /// data_path(name), single-quoted for /bin/sh: a bundled mesh as a CLI argument.
 inline std::string quoted_data_path(const std::string& name) {
@@ -86,6 +88,12 @@ inline std::string quoted_data_path(const std::string& name) {
 /// Expects `output` to be manifold and oriented with the same genus, components and boundary
 /// loops as `input` (gtest assertions).
 void expect_same_topology(const Mesh& input, const Mesh& output);
+
+/// The guard's quality floor of every face as FlowOptions::min_quality states it, computed
+/// here from that text (not by the library's code): min(min_quality, the worst input radius
+/// ratio of the faces around the face's corners), and for a face starting below min_quality at
+/// most sliver_floor times its input ratio.
+Eigen::VectorXd stated_quality_floor(const Mesh& input, double min_quality, double sliver_floor);
 
 /// The whole content of a file (empty if it cannot be read).
 std::string read_text(const std::filesystem::path& path);
