@@ -52,7 +52,9 @@ std::string& last_input() {
 }
 }  // namespace
 
-const std::string& last_input_path() { return last_input(); }
+const std::string& last_input_path() {
+  return last_input();
+}
 
 Mesh read_mesh_with_warnings(const std::filesystem::path& path, const GlobalOptions& global, ReadReport* report) {
   last_input() = path.string();
@@ -60,7 +62,8 @@ Mesh read_mesh_with_warnings(const std::filesystem::path& path, const GlobalOpti
   ReadReport& r = report ? *report : local;
   Mesh mesh = read_mesh(path, &r);
   if (!global.quiet) {
-    for (const std::string& warning : r.warnings()) fmt::print(stderr, "vertexflow: warning: {}: {}\n", path.string(), warning);
+    for (const std::string& warning : r.warnings())
+      fmt::print(stderr, "vertexflow: warning: {}: {}\n", path.string(), warning);
   }
   return mesh;
 }
@@ -80,25 +83,49 @@ nlohmann::json to_json(const QualityStats& stats) {
           {"histogram", stats.histogram}};
 }
 
+nlohmann::json to_json(const SurfaceRepairs& repairs) {
+  return {{"input_split_vertices", repairs.input_split.held_vertices},
+          {"input_reoriented_faces", repairs.input_split.reversed_faces},
+          {"input_cut_edges", repairs.input_split.cut_edges},
+          {"removed_degenerate_faces", repairs.removed_degenerate_faces},
+          {"duplicated_vertices", repairs.duplicated_vertices}};
+}
+
+void warn_about_repairs(const std::string& input, const SurfaceRepairs& repairs, const GlobalOptions& global) {
+  if (global.quiet) return;
+  const ManifoldSplitCounts& split = repairs.input_split;
+  if (split.any())
+    fmt::print(stderr,
+               "vertexflow: warning: {}: the mesh is not manifold or not consistently oriented: {} vertices split "
+               "into one copy per fan, {} faces reoriented, {} edges treated as boundaries\n",
+               input, split.held_vertices, split.reversed_faces, split.cut_edges);
+  if (repairs.removed_degenerate_faces + repairs.duplicated_vertices > 0)
+    fmt::print(stderr,
+               "vertexflow: warning: {}: the result had {} zero-area faces (removed) and {} vertices pinched between "
+               "fans (duplicated)\n",
+               input, repairs.removed_degenerate_faces, repairs.duplicated_vertices);
+}
+
 nlohmann::json to_json(const MeshInfo& info) {
   const auto vec = [](const Eigen::Vector3d& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); };
-  return {{"vertices", info.num_vertices},
-          {"faces", info.num_faces},
-          {"edges", info.num_edges},
-          {"bounding_box", {{"min", vec(info.bounding_box.min)}, {"max", vec(info.bounding_box.max)}}},
-          {"diagonal", info.diagonal},
-          {"edge_length", {{"mean", info.edge_length_mean}, {"min", info.edge_length_min}, {"max", info.edge_length_max}}},
-          {"surface_area", info.surface_area},
-          {"components", info.components},
-          {"boundary_loops", info.boundary_loops},
-          {"euler_characteristic", info.euler_characteristic},
-          {"genus", info.genus >= 0 ? nlohmann::json(info.genus) : nlohmann::json(nullptr)},
-          {"manifold", info.manifold},
-          {"oriented", info.oriented},
-          {"closed", info.closed},
-          {"non_manifold_edges", info.non_manifold_edges},
-          {"non_manifold_vertices", info.non_manifold_vertices},
-          {"quality", to_json(info.quality)}};
+  return {
+      {"vertices", info.num_vertices},
+      {"faces", info.num_faces},
+      {"edges", info.num_edges},
+      {"bounding_box", {{"min", vec(info.bounding_box.min)}, {"max", vec(info.bounding_box.max)}}},
+      {"diagonal", info.diagonal},
+      {"edge_length", {{"mean", info.edge_length_mean}, {"min", info.edge_length_min}, {"max", info.edge_length_max}}},
+      {"surface_area", info.surface_area},
+      {"components", info.components},
+      {"boundary_loops", info.boundary_loops},
+      {"euler_characteristic", info.euler_characteristic},
+      {"genus", info.genus >= 0 ? nlohmann::json(info.genus) : nlohmann::json(nullptr)},
+      {"manifold", info.manifold},
+      {"oriented", info.oriented},
+      {"closed", info.closed},
+      {"non_manifold_edges", info.non_manifold_edges},
+      {"non_manifold_vertices", info.non_manifold_vertices},
+      {"quality", to_json(info.quality)}};
 }
 
 nlohmann::json to_json(const ReadReport& report) {

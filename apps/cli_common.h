@@ -3,6 +3,7 @@
 
 #include "vertexflow/distance.h"
 #include "vertexflow/io.h"
+#include "vertexflow/manifold_split.h"
 #include "vertexflow/mesh_info.h"
 
 #include <CLI/CLI.hpp>
@@ -50,6 +51,11 @@ std::string describe_format(const ReadReport& report);
 
 nlohmann::json to_json(const MeshInfo& info);
 nlohmann::json to_json(const QualityStats& stats);
+nlohmann::json to_json(const SurfaceRepairs& repairs);
+
+/// Prints (unless quiet) one warning line per kind of repair remesh or simplify made to `input`
+/// or to their result (manifold_split.h).
+void warn_about_repairs(const std::string& input, const SurfaceRepairs& repairs, const GlobalOptions& global);
 nlohmann::json to_json(const ReadReport& report);
 /// mean, rms, max (absolute), the same divided by `length_scale` (*_relative), and points.
 nlohmann::json to_json(const DistanceStats& stats, double length_scale);

@@ -27,7 +27,7 @@ void register_remesh_command(CLI::App& app, const GlobalOptions& global) {
   auto o = std::make_shared<RemeshCommandOptions>();
   CLI::App* command = app.add_subcommand(
       "remesh", "Uniform isotropic remeshing onto the input surface (CGAL), to a vertex count or an edge length");
-  command->add_option("IN", o->input, "Input mesh (manifold, consistently oriented)")->required();
+  command->add_option("IN", o->input, "Input mesh (a non-manifold one is split where it is not a disc)")->required();
   command->add_option("OUT", o->output, "Output mesh")->required();
   CLI::Option_group* size = command->add_option_group("size", "Exactly one of");
   size->add_option("--target-vertices", o->remesh.target_vertices,
@@ -56,7 +56,7 @@ void register_remesh_command(CLI::App& app, const GlobalOptions& global) {
     try {
       if (o->edge_length > 0) {
         const auto start = std::chrono::steady_clock::now();
-        result.mesh = remesh_isotropic(mesh.V, mesh.F, o->edge_length, o->remesh.isotropic);
+        result.mesh = remesh_isotropic(mesh.V, mesh.F, o->edge_length, o->remesh.isotropic, &result.report.repairs);
         const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         result.report.attempts.push_back({o->edge_length, result.mesh.num_vertices(), seconds});
         result.report.edge_length = o->edge_length;
@@ -83,6 +83,7 @@ void register_remesh_command(CLI::App& app, const GlobalOptions& global) {
         fmt::print(stderr, "vertexflow: warning: {}: {} vertices is outside the {}% tolerance after {} runs\n",
                    o->input, result.mesh.num_vertices(), 100 * o->remesh.tolerance, r.attempts.size());
     }
+    warn_about_repairs(o->input, r.repairs, global);
     write_mesh(o->output, result.mesh);
     if (o->json) {
       nlohmann::json out;
@@ -104,6 +105,7 @@ void register_remesh_command(CLI::App& app, const GlobalOptions& global) {
       out["protect_boundary"] = o->remesh.isotropic.protect_boundary;
       out["seconds"] = r.seconds;
       out["quality"] = to_json(quality);
+      out["repairs"] = to_json(r.repairs);
       fmt::print("{}\n", out.dump(2));
     }
   });

@@ -25,7 +25,7 @@ void register_simplify_command(CLI::App& app, const GlobalOptions& global) {
   auto o = std::make_shared<SimplifyCommandOptions>();
   CLI::App* command =
       app.add_subcommand("simplify", "Simplify by quadric-error edge collapse (Garland-Heckbert), boundaries kept");
-  command->add_option("IN", o->input, "Input mesh (manifold, consistently oriented)")->required();
+  command->add_option("IN", o->input, "Input mesh (a non-manifold one is split where it is not a disc)")->required();
   command->add_option("OUT", o->output, "Output mesh")->required();
   CLI::Option_group* budget = command->add_option_group("face budget", "Exactly one of");
   budget->add_option("--faces", o->simplify.target_faces, "Faces wanted (the result has N or N + 1)")
@@ -57,6 +57,7 @@ void register_simplify_command(CLI::App& app, const GlobalOptions& global) {
         fmt::print(stderr, "vertexflow: warning: {}: no further edge could be collapsed; {} faces remain\n", o->input,
                    r.output_faces);
     }
+    warn_about_repairs(o->input, r.repairs, global);
     write_mesh(o->output, result.mesh);
     if (o->json) {
       nlohmann::json out;
@@ -71,6 +72,7 @@ void register_simplify_command(CLI::App& app, const GlobalOptions& global) {
       out["keep_boundary"] = o->simplify.keep_boundary;
       out["seconds"] = r.seconds;
       out["quality"] = to_json(quality);
+      out["repairs"] = to_json(r.repairs);
       fmt::print("{}\n", out.dump(2));
     }
   });

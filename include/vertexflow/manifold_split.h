@@ -23,6 +23,23 @@
 
 namespace vertexflow {
 
+/// What split_non_manifold changed, for the reports of the stages that use it.
+struct ManifoldSplitCounts {
+  Index held_vertices = 0;   ///< input vertices split into more than one copy
+  Index reversed_faces = 0;  ///< faces reversed to agree with their component
+  Index cut_edges = 0;       ///< non-manifold edges and orientation conflicts cut
+  [[nodiscard]] bool any() const { return held_vertices + reversed_faces + cut_edges > 0; }
+};
+
+/// What the CGAL-based stages (remesh.h, simplify.h) repaired: the input they converted
+/// through its manifold split, and what they removed or duplicated in their output so that it
+/// is manifold, consistently oriented and has no zero-area face.
+struct SurfaceRepairs {
+  ManifoldSplitCounts input_split;
+  Index removed_degenerate_faces = 0;  ///< zero-area faces left by the collapses, removed
+  Index duplicated_vertices = 0;       ///< vertices pinched between fans, duplicated
+};
+
 struct ManifoldSplit {
   /// The copy's vertices: input vertex source_vertex[s] for copy s, at the same position.
   Vertices V;
@@ -47,6 +64,9 @@ struct ManifoldSplit {
   /// Whether the input was already manifold and consistently oriented (then V, F equal the input).
   [[nodiscard]] bool unchanged() const {
     return held_vertices == 0 && reversed_faces == 0 && cut_non_manifold_edges == 0 && cut_orientation_edges == 0;
+  }
+  [[nodiscard]] ManifoldSplitCounts counts() const {
+    return {held_vertices, reversed_faces, cut_non_manifold_edges + cut_orientation_edges};
   }
 };
 

@@ -17,10 +17,15 @@
 //   loops are those of the input.
 // - Output: new vertices and faces, consistently oriented like the input. Colours and vertex
 //   properties are not carried over.
-// - Input: a manifold, consistently oriented triangle mesh (topology.h); anything else throws
-//   std::invalid_argument.
+// - Input: any triangle mesh. One that is not manifold or not consistently oriented is remeshed
+//   through its manifold split (manifold_split.h): non-manifold vertices duplicated,
+//   non-manifold edges cut into boundaries, faces oriented per component.
+// - Output: manifold and consistently oriented, without zero-area faces; what it took is in
+//   SurfaceRepairs (on inputs with many holes CGAL's collapses can pinch a vertex between two
+//   loops or leave a zero-area face).
 #pragma once
 
+#include "vertexflow/manifold_split.h"
 #include "vertexflow/mesh.h"
 
 #include <vector>
@@ -38,11 +43,12 @@ struct IsotropicRemeshOptions {
 };
 
 /// Remeshes (V, F) with target edge length `edge_length` (> 0, input units): CGAL splits edges
-/// longer than 4/3 of it and collapses those shorter than 4/5 of it. Throws
-/// std::invalid_argument for an empty, non-manifold or inconsistently oriented mesh, or a
-/// length that would give more than 50 million vertices (estimated from the area).
-Mesh remesh_isotropic(const Vertices& V, const Faces& F, double edge_length,
-                      const IsotropicRemeshOptions& options = {});
+/// longer than 4/3 of it and collapses those shorter than 4/5 of it. `repairs` (if given)
+/// receives what was repaired (see above). Throws std::invalid_argument for an empty mesh, an
+/// index out of range, or a length that would give more than 50 million vertices (estimated
+/// from the area).
+Mesh remesh_isotropic(const Vertices& V, const Faces& F, double edge_length, const IsotropicRemeshOptions& options = {},
+                      SurfaceRepairs* repairs = nullptr);
 
 /// Target edge length for about `vertices` vertices of near-equilateral triangles covering
 /// `area`: a closed mesh has F ~ 2 V faces of area (sqrt 3 / 4) L^2, so
@@ -71,7 +77,8 @@ struct RemeshReport {
   std::vector<RemeshAttempt> attempts;
   double edge_length = 0;  ///< of the returned result
   bool within_tolerance = false;
-  double seconds = 0;  ///< all attempts
+  double seconds = 0;      ///< all attempts
+  SurfaceRepairs repairs;  ///< of the returned result
 };
 
 struct RemeshResult {

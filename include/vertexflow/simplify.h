@@ -17,10 +17,13 @@
 // - Output: vertices are the surviving input vertices in their input order (interior ones at
 //   their new optimal positions); faces keep their orientation; genus, components and boundary
 //   loops are those of the input. Colours and vertex properties are not carried over.
-// - Input: a manifold, consistently oriented triangle mesh (topology.h); anything else throws
-//   std::invalid_argument (describe_non_manifold).
+// - Input: any triangle mesh; one that is not manifold or not consistently oriented is
+//   simplified through its manifold split (manifold_split.h), as in remesh.h.
+// - Output: manifold and consistently oriented, without zero-area faces (SimplifyReport::repairs
+//   says what it took).
 #pragma once
 
+#include "vertexflow/manifold_split.h"
 #include "vertexflow/mesh.h"
 
 namespace vertexflow {
@@ -42,6 +45,7 @@ struct SimplifyReport {
   Index collapses = 0;          ///< edges collapsed
   bool reached_target = false;  ///< output_faces <= target_faces + 1
   double seconds = 0;           ///< conversion, collapses and conversion back
+  SurfaceRepairs repairs;
 };
 
 struct SimplifyResult {
@@ -50,8 +54,8 @@ struct SimplifyResult {
 };
 
 /// Simplifies (V, F) to the face budget of `options`. A budget at or above #F returns the input
-/// unchanged (apart from dropping unreferenced vertices). Throws std::invalid_argument for an
-/// empty, non-manifold or inconsistently oriented mesh, or options out of range.
+/// unchanged (apart from dropping unreferenced vertices, and the repairs above). Throws
+/// std::invalid_argument for an empty mesh, an index out of range, or options out of range.
 SimplifyResult simplify(const Vertices& V, const Faces& F, const SimplifyOptions& options = {});
 
 }  // namespace vertexflow

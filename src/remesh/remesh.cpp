@@ -28,12 +28,12 @@ void check_options(const IsotropicRemeshOptions& options) {
 }
 
 // Remeshes a copy of `input`, so every attempt starts from (and projects onto) the input.
-Mesh run(SurfaceMesh mesh, double edge_length, const IsotropicRemeshOptions& options) {
+Mesh run(SurfaceMesh mesh, double edge_length, const IsotropicRemeshOptions& options, SurfaceRepairs& repairs) {
   PMP::isotropic_remeshing(faces(mesh), edge_length, mesh,
                            CGAL::parameters::number_of_iterations(static_cast<unsigned>(options.iterations))
                                .number_of_relaxation_steps(static_cast<unsigned>(options.relaxation_steps))
                                .protect_constraints(options.protect_boundary));
-  return remesh_detail::from_surface_mesh(mesh);
+  return remesh_detail::from_surface_mesh(mesh, &repairs);
 }
 
 // CGAL collapses an edge only while it is shorter than 4/5 of the target and splits it once it
@@ -50,7 +50,8 @@ double surface_area(const Vertices& V, const Faces& F) {
   double area = 0;
   for (Index f = 0; f < F.rows(); ++f) area += face_area(V, F, f);
   if (!(area > 0) || !std::isfinite(area))
-    throw std::invalid_argument(fmt::format("remesh: the mesh's surface area is {:g}; there is nothing to remesh", area));
+    throw std::invalid_argument(
+        fmt::format("remesh: the mesh's surface area is {:g}; there is nothing to remesh", area));
   return area;
 }
 
@@ -67,13 +68,17 @@ void check_vertex_estimate(double area, double edge_length) {
 
 }  // namespace
 
-Mesh remesh_isotropic(const Vertices& V, const Faces& F, double edge_length, const IsotropicRemeshOptions& options) {
+Mesh remesh_isotropic(const Vertices& V, const Faces& F, double edge_length, const IsotropicRemeshOptions& options,
+                      SurfaceRepairs* repairs) {
   if (!(edge_length > 0) || !std::isfinite(edge_length))
     throw std::invalid_argument("remesh: the target edge length must be positive");
   check_options(options);
-  SurfaceMesh mesh = remesh_detail::to_surface_mesh(V, F, "remesh");
+  SurfaceRepairs counts;
+  SurfaceMesh mesh = remesh_detail::to_surface_mesh(V, F, "remesh", &counts.input_split);
   check_vertex_estimate(surface_area(V, F), edge_length);
-  return run(std::move(mesh), edge_length, options);
+  Mesh out = run(std::move(mesh), edge_length, options, counts);
+  if (repairs) *repairs = counts;
+  return out;
 }
 
 double edge_length_for_vertex_count(double area, Index vertices) {
@@ -87,7 +92,8 @@ RemeshResult remesh_to_vertex_count(const Vertices& V, const Faces& F, const Rem
   if (!(options.tolerance >= 0)) throw std::invalid_argument("remesh: the tolerance must not be negative");
   if (options.max_attempts < 1) throw std::invalid_argument("remesh: max_attempts must be at least 1");
   check_options(options.isotropic);
-  const SurfaceMesh input = remesh_detail::to_surface_mesh(V, F, "remesh");
+  ManifoldSplitCounts input_split;
+  const SurfaceMesh input = remesh_detail::to_surface_mesh(V, F, "remesh", &input_split);
   const double target = options.target_vertices;
 
   RemeshResult best;
@@ -97,7 +103,8 @@ RemeshResult remesh_to_vertex_count(const Vertices& V, const Faces& F, const Rem
   for (int attempt = 0; attempt < options.max_attempts; ++attempt) {
     check_vertex_estimate(area, length);
     const auto attempt_start = std::chrono::steady_clock::now();
-    Mesh mesh = run(input, length, options.isotropic);
+    SurfaceRepairs repairs{input_split, 0, 0};
+    Mesh mesh = run(input, length, options.isotropic, repairs);
     const Index count = mesh.num_vertices();
     best.report.attempts.push_back({length, count, seconds_since(attempt_start)});
     const double error = std::abs(count - target);
@@ -105,6 +112,7 @@ RemeshResult remesh_to_vertex_count(const Vertices& V, const Faces& F, const Rem
       best_error = error;
       best.mesh = std::move(mesh);
       best.report.edge_length = length;
+      best.report.repairs = repairs;
     }
     if (error <= options.tolerance * target || count == 0) break;
     // #V ~ c L^-p. Once runs on both sides of the target are known, interpolate between the

@@ -33,13 +33,6 @@ struct FaceBudget {
   }
 };
 
-Index referenced_vertices(const Faces& F, Index num_vertices) {
-  std::vector<char> used(static_cast<std::size_t>(num_vertices), 0);
-  for (Index f = 0; f < F.rows(); ++f)
-    for (int k = 0; k < 3; ++k) used[static_cast<std::size_t>(F(f, k))] = 1;
-  return static_cast<Index>(std::count(used.begin(), used.end(), char{1}));
-}
-
 }  // namespace
 
 SimplifyResult simplify(const Vertices& V, const Faces& F, const SimplifyOptions& options) {
@@ -47,14 +40,16 @@ SimplifyResult simplify(const Vertices& V, const Faces& F, const SimplifyOptions
   if (options.target_faces < 0) throw std::invalid_argument("simplify: the target face count is negative");
   if (options.target_faces == 0 && !(options.target_ratio > 0 && options.target_ratio <= 1))
     throw std::invalid_argument("simplify: the target ratio must be in (0, 1]");
-  SurfaceMesh mesh = remesh_detail::to_surface_mesh(V, F, "simplify");
-
   SimplifyReport report;
+  SurfaceMesh mesh = remesh_detail::to_surface_mesh(V, F, "simplify", &report.repairs.input_split);
+
   report.input_faces = static_cast<Index>(F.rows());
   report.target_faces =
       options.target_faces > 0
           ? options.target_faces
           : std::max<Index>(1, static_cast<Index>(std::lround(options.target_ratio * static_cast<double>(F.rows()))));
+  // Every collapse removes exactly one vertex (CGAL's return value counts removed edges).
+  const auto vertices_before = mesh.number_of_vertices();
   if (report.target_faces < report.input_faces) {
     const FaceBudget stop{static_cast<std::size_t>(report.target_faces)};
     Quadrics quadrics(mesh);
@@ -72,10 +67,9 @@ SimplifyResult simplify(const Vertices& V, const Faces& F, const SimplifyOptions
     }
   }
 
-  SimplifyResult result{remesh_detail::from_surface_mesh(mesh), {}};
+  report.collapses = static_cast<Index>(vertices_before - mesh.number_of_vertices());
+  SimplifyResult result{remesh_detail::from_surface_mesh(mesh, &report.repairs), {}};
   report.output_faces = result.mesh.num_faces();
-  // Every collapse removes exactly one vertex.
-  report.collapses = referenced_vertices(F, static_cast<Index>(V.rows())) - result.mesh.num_vertices();
   report.reached_target = report.output_faces <= report.target_faces + 1;
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   result.report = report;

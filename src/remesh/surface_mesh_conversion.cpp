@@ -2,19 +2,20 @@
 
 #include "vertexflow/topology.h"
 
+#include <CGAL/Polygon_mesh_processing/manifoldness.h>
+#include <CGAL/Polygon_mesh_processing/repair_degeneracies.h>
+
 #include <stdexcept>
 #include <vector>
 
 namespace vertexflow::remesh_detail {
 
-SurfaceMesh to_surface_mesh(const Vertices& V, const Faces& F, const std::string& stage) {
-  if (V.rows() == 0 || F.rows() == 0) throw std::invalid_argument(stage + ": the mesh is empty");
-  // build_topology also checks the indices and repeated vertices.
-  const Topology topology = build_topology(F, static_cast<Index>(V.rows()));
-  if (!topology.is_manifold()) throw std::invalid_argument(stage + ": " + describe_non_manifold(topology));
-  if (!topology.is_oriented)
-    throw std::invalid_argument(stage + ": the faces are not consistently oriented (or the surface is not orientable)");
+namespace PMP = CGAL::Polygon_mesh_processing;
 
+namespace {
+
+SurfaceMesh manifold_to_surface_mesh(const Vertices& V, const Faces& F, const Topology& topology,
+                                     const std::string& stage) {
   SurfaceMesh mesh;
   mesh.reserve(static_cast<SurfaceMesh::size_type>(V.rows()), static_cast<SurfaceMesh::size_type>(topology.num_edges()),
                static_cast<SurfaceMesh::size_type>(F.rows()));
@@ -23,14 +24,40 @@ SurfaceMesh to_surface_mesh(const Vertices& V, const Faces& F, const std::string
     const auto face = mesh.add_face(SurfaceMesh::Vertex_index(static_cast<SurfaceMesh::size_type>(F(f, 0))),
                                     SurfaceMesh::Vertex_index(static_cast<SurfaceMesh::size_type>(F(f, 1))),
                                     SurfaceMesh::Vertex_index(static_cast<SurfaceMesh::size_type>(F(f, 2))));
-    // Cannot happen after the checks above; kept so that a gap in them is an error, not a hole.
+    // Cannot happen for a manifold, oriented F; kept so that a gap in that is an error, not a hole.
     if (face == SurfaceMesh::null_face())
       throw std::invalid_argument(stage + ": face " + std::to_string(f) + " cannot be added to a halfedge mesh");
   }
   return mesh;
 }
 
-Mesh from_surface_mesh(const SurfaceMesh& mesh) {
+}  // namespace
+
+SurfaceMesh to_surface_mesh(const Vertices& V, const Faces& F, const std::string& stage, ManifoldSplitCounts* split) {
+  if (V.rows() == 0 || F.rows() == 0) throw std::invalid_argument(stage + ": the mesh is empty");
+  // build_topology also checks the indices and repeated vertices.
+  const Topology topology = build_topology(F, static_cast<Index>(V.rows()));
+  if (topology.is_manifold() && topology.is_oriented) {
+    if (split) *split = {};
+    return manifold_to_surface_mesh(V, F, topology, stage);
+  }
+  const ManifoldSplit copy = split_non_manifold(V, F, topology);
+  if (split) *split = copy.counts();
+  return manifold_to_surface_mesh(copy.V, copy.F, build_topology(copy.F, static_cast<Index>(copy.V.rows())), stage);
+}
+
+Mesh from_surface_mesh(SurfaceMesh& mesh, SurfaceRepairs* repairs) {
+  // CGAL's collapses can leave zero-area faces and vertices pinched between two boundary
+  // loops where holes are close (a remesh of a scan with holes: 128 and 72 of them), which
+  // the flow and the metrics refuse. Removing degenerate faces can itself pinch a vertex, so
+  // it comes first.
+  const auto faces_before = mesh.number_of_faces();
+  PMP::remove_degenerate_faces(mesh);
+  const auto duplicated = PMP::duplicate_non_manifold_vertices(mesh);
+  if (repairs) {
+    repairs->removed_degenerate_faces = static_cast<Index>(faces_before - mesh.number_of_faces());
+    repairs->duplicated_vertices = static_cast<Index>(duplicated);
+  }
   // Surface_mesh iterators skip removed elements; vertex indices are renumbered densely.
   std::vector<Index> new_index(mesh.num_vertices(), -1);
   Index count = 0;

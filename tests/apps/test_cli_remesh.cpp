@@ -62,9 +62,6 @@ TEST(CliSimplify, BadInputFailsCleanly) {
   test::ScratchDir dir("cli-simplify-bad");
   const auto out = dir.file("out.off");
   expect_one_line_error(
-      run_cli("simplify " + shell_quote(write_bowtie(dir).string()) + " " + shell_quote(out.string()) + " --faces 1"),
-      "bowtie.obj: simplify: the mesh is not manifold");
-  expect_one_line_error(
       run_cli("simplify " + quoted_data_path("spot.obj") + " " + shell_quote(out.string()) + " --ratio 0"),
       "spot.obj: simplify: the target ratio must be in (0, 1]");
   expect_one_line_error(run_cli("simplify /nonexistent/in.off " + shell_quote(out.string()) + " --faces 10"),
@@ -104,12 +101,29 @@ TEST(CliRemesh, ReportsCountAndQuality) {
   EXPECT_GT(read_mesh(fixed).num_vertices(), 100);
 }
 
+// A non-manifold input is remeshed and simplified through its split, with one warning line
+// that names the file and says what was split, and the counts in --json.
+TEST(CliRemeshAndSimplify, NonManifoldInputIsSplitWithAWarning) {
+  test::ScratchDir dir("cli-remesh-non-manifold");
+  const auto bowtie = write_bowtie(dir);
+  const auto out = dir.file("out.off");
+  for (const std::string command : {"remesh --edge-length 0.25", "simplify --faces 2"}) {
+    const auto r = run_cli(command.substr(0, command.find(' ')) + " " + shell_quote(bowtie.string()) + " " +
+                           shell_quote(out.string()) + command.substr(command.find(' ')) + " --json");
+    ASSERT_EQ(r.exit_code, 0) << command << ": " << r.err;
+    EXPECT_NE(r.err.find("vertexflow: warning: " + bowtie.string() +
+                         ": the mesh is not manifold or not consistently oriented: 1 vertices split"),
+              std::string::npos)
+        << r.err;
+    EXPECT_EQ(nlohmann::json::parse(r.out)["repairs"]["input_split_vertices"], 1) << command;
+    const Mesh result = read_mesh(out);
+    test::expect_clean_surface(result);
+  }
+}
+
 TEST(CliRemesh, BadInputFailsCleanly) {
   test::ScratchDir dir("cli-remesh-bad");
   const auto out = dir.file("out.off");
-  expect_one_line_error(run_cli("remesh " + shell_quote(write_bowtie(dir).string()) + " " + shell_quote(out.string()) +
-                                " --target-vertices 100"),
-                        "bowtie.obj: remesh: the mesh is not manifold");
   expect_one_line_error(
       run_cli("remesh " + quoted_data_path("spot.obj") + " " + shell_quote(out.string()) + " --edge-length 1e-7"),
       "spot.obj: remesh: the edge length 1e-07 would give about");

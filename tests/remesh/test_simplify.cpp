@@ -3,7 +3,9 @@
 #include "shapes.h"
 #include "test_support.h"
 
+#include "vertexflow/flow.h"
 #include "vertexflow/io.h"
+#include "vertexflow/quality.h"
 #include "vertexflow/simplify.h"
 #include "vertexflow/topology.h"
 
@@ -148,22 +150,39 @@ TEST(Simplify, BudgetAtOrAboveTheInputChangesNothing) {
   EXPECT_EQ(result.report.collapses, 0);
 }
 
-TEST(Simplify, RefusesWhatAHalfedgeMeshCannotHold) {
-  const Mesh bowtie = test::bowtie();
-  try {
-    simplify(bowtie.V, bowtie.F);
-    FAIL() << "non-manifold mesh accepted";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("simplify: the mesh is not manifold"), std::string::npos) << e.what();
-  }
-  Mesh flipped = test::icosphere(1.0, 1);
+// Non-manifold and inconsistently oriented input is simplified through its manifold split: the
+// result is clean, and the flow takes it with refuse_non_manifold.
+TEST(Simplify, NonManifoldAndMisorientedInputGiveACleanMesh) {
+  Mesh flipped = test::icosphere(1.0, 2);
   flipped.F.row(3) = flipped.F.row(3).reverse().eval();
-  try {
-    simplify(flipped.V, flipped.F);
-    FAIL() << "inconsistently oriented mesh accepted";
-  } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("not consistently oriented"), std::string::npos) << e.what();
-  }
+  SimplifyOptions half;
+  half.target_ratio = 0.5;
+  const SimplifyResult oriented = simplify(flipped.V, flipped.F, half);
+  test::expect_clean_surface(oriented.mesh);
+  EXPECT_EQ(oriented.report.repairs.input_split.reversed_faces, 1);
+  EXPECT_EQ(oriented.report.output_faces, 160);
+
+  const Mesh scan = test::with_random_faces_removed(read_mesh(test::data_path("bunny.off")), 2000, 5);
+  const Topology topology = build_topology(scan.F, scan.num_vertices());
+  ASSERT_GE(topology.boundary_loops.size(), 100u);
+  ASSERT_FALSE(topology.is_manifold());
+  SimplifyOptions options;
+  options.target_faces = 12000;
+  const SimplifyResult result = simplify(scan.V, scan.F, options);
+  std::cout << "[measured] bunny.off minus 2000 faces -> " << result.report.output_faces << " faces; split "
+            << result.report.repairs.input_split.held_vertices << ", removed degenerate "
+            << result.report.repairs.removed_degenerate_faces << ", duplicated "
+            << result.report.repairs.duplicated_vertices << "\n";
+  test::expect_clean_surface(result.mesh);
+  EXPECT_TRUE(result.report.reached_target);
+  EXPECT_GT(result.report.repairs.input_split.held_vertices, 100);
+  FlowOptions strict;
+  strict.refuse_non_manifold = true;
+  const FlowResult flowed = vertex_flow(result.mesh.V, result.mesh.F, strict);
+  EXPECT_TRUE(flipped_faces(result.mesh.V, flowed.V, result.mesh.F).empty());
+}
+
+TEST(Simplify, RefusesBadOptions) {
   const Mesh sphere = test::icosphere(1.0, 1);
   SimplifyOptions options;
   options.target_ratio = 0;

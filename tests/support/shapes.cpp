@@ -250,6 +250,23 @@ Mesh sliver_plate(int holes, int slivers, double thickness, double jitter, unsig
   return plate;
 }
 
+Mesh with_random_faces_removed(const Mesh& mesh, Index count, unsigned seed) {
+  std::vector<Index> order(static_cast<std::size_t>(mesh.num_faces()));
+  for (std::size_t f = 0; f < order.size(); ++f) order[f] = static_cast<Index>(f);
+  std::mt19937 random(seed);
+  std::shuffle(order.begin(), order.end(), random);
+  std::vector<char> removed(order.size(), 0);
+  for (Index k = 0; k < std::min(count, mesh.num_faces()); ++k) removed[static_cast<std::size_t>(order[k])] = 1;
+  Mesh out;
+  out.V = mesh.V;
+  out.F.resize(mesh.num_faces() - std::min(count, mesh.num_faces()), 3);
+  Index row = 0;
+  for (Index f = 0; f < mesh.num_faces(); ++f) {
+    if (!removed[static_cast<std::size_t>(f)]) out.F.row(row++) = mesh.F.row(f);
+  }
+  return out;
+}
+
 Mesh noisy_scan(const Mesh& mesh, double normal_noise, double tangential_jitter, unsigned seed) {
   const Topology topology = build_topology(mesh.F, mesh.num_vertices());
   const double edge = mean_edge_length(mesh.V, topology);

@@ -40,6 +40,11 @@ Mesh perforated_plate(int holes, int subdivisions, double thickness, bool bottom
 /// faces start below radius ratio 0.3.
 Mesh sliver_plate(int holes, int slivers, double thickness, double jitter, unsigned seed);
 
+/// `mesh` with `count` faces chosen uniformly at random (fixed seed) removed, vertices kept:
+/// a scan with many small holes. Holes that touch at a vertex make it non-manifold, as in
+/// real scans.
+Mesh with_random_faces_removed(const Mesh& mesh, Index count, unsigned seed);
+
 /// Vertex-clustering decimation of `mesh` (Rossignac and Borrel 1993), the way the Stanford
 /// repository's low-resolution scans were made: vertices are merged per cube of a grid of
 /// `cell` edge length (at the mean of the cube's vertices), faces with two corners in one cube

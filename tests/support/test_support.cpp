@@ -145,6 +145,17 @@ Eigen::VectorXd stated_quality_floor(const Mesh& input, double min_quality, doub
   return floor;
 }
 
+void expect_clean_surface(const Mesh& mesh) {
+  const Topology topology = build_topology(mesh.F, mesh.num_vertices());
+  EXPECT_TRUE(topology.is_manifold()) << describe_non_manifold(topology);
+  EXPECT_TRUE(topology.is_oriented);
+  EXPECT_TRUE(degenerate_faces(mesh.V, mesh.F).empty());
+  for (Index v = 0; v < mesh.num_vertices(); ++v)
+    ASSERT_LT(topology.face_offsets[static_cast<std::size_t>(v)],
+              topology.face_offsets[static_cast<std::size_t>(v) + 1])
+        << "unreferenced vertex " << v;
+}
+
 void expect_same_topology(const Mesh& input, const Mesh& output) {
   const Topology before = build_topology(input.F, input.num_vertices());
   const Topology after = build_topology(output.F, output.num_vertices());

@@ -89,6 +89,11 @@ inline std::string quoted_data_path(const std::string& name) {
 /// loops as `input` (gtest assertions).
 void expect_same_topology(const Mesh& input, const Mesh& output);
 
+/// Expects what remesh.h and simplify.h promise of their output, and what the flow needs to
+/// take it with FlowOptions::refuse_non_manifold: manifold, consistently oriented, no face of
+/// zero area (degenerate_faces), no unreferenced vertex.
+void expect_clean_surface(const Mesh& mesh);
+
 /// The guard's quality floor of every face as FlowOptions::min_quality states it, computed
 /// here from that text (not by the library's code): min(min_quality, the worst input radius
 /// ratio of the faces around the face's corners), and for a face starting below min_quality at
