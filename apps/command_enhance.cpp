@@ -3,6 +3,8 @@
 #include "cli_common.h"
 #include "report_support.h"
 
+#include "vertexflow/distance.h"
+#include "vertexflow/fit.h"
 #include "vertexflow/flow.h"
 #include "vertexflow/html_report.h"
 #include "vertexflow/report_json.h"
@@ -15,6 +17,7 @@
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstring>
 #include <functional>
@@ -35,6 +38,8 @@ struct EnhanceOptions {
   std::string report_file;
   std::string html_file;
   FlowOptions flow;
+  std::string reference_file;
+  FitOptions fit;
   std::string method = "flow";
   UnsharpOptions unsharp;
   bool keep_boundary_free = false;
@@ -171,6 +176,28 @@ MethodRun run_flow(const Mesh& mesh, const Topology& topology, const FlowOptions
   return run;
 }
 
+// Reference mode (fit.h): the vertices fitted to a dense mesh of the true surface. Report:
+// options, the fit's rounds and distances, guard, seconds.
+MethodRun run_reference(const Mesh& mesh, const Mesh& reference, const FitOptions& options, const Progress& phase) {
+  FitResult result = fit_to_reference(mesh.V, mesh.F, reference.V, reference.F, options);
+  const FitReport& r = result.report;
+  phase(
+      fmt::format("fitted in {} rounds{}: RMS distance {:.6g} -> {:.6g}; tree {:.3f} s, queries {:.3f} s, solve "
+                  "{:.3f} s, guard {:.3f} s; {} vertices limited by the guard",
+                  r.rounds, r.converged ? "" : " (max-rounds reached)", r.rms_distance.front(), r.rms_distance.back(),
+                  r.seconds_tree, r.seconds_queries, r.seconds_solve, r.seconds_guard, r.limited_vertices));
+  MethodRun run;
+  run.report = r;
+  run.report["fit"] = {{"rms_distance", run.report["rms_distance"]},
+                       {"rounds", r.rounds},
+                       {"converged", r.converged},
+                       {"reference_samples", r.reference_samples}};
+  for (const char* key : {"rms_distance", "rounds", "converged", "reference_samples"}) run.report.erase(key);
+  run.report["options"] = options;
+  run.V = std::move(result.V);
+  return run;
+}
+
 // The unsharp-mask baseline (unsharp.h). Report: options, fixed_vertices, seconds.
 MethodRun run_unsharp(const Mesh& mesh, const UnsharpOptions& options) {
   const auto start = Clock::now();
@@ -252,19 +279,36 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
                     "Refuse a non-manifold or inconsistently oriented mesh (default: hold its non-manifold vertices "
                     "and flow the rest)");
   command->add_option("--report", o->report_file, "Write a JSON report: options, timings per phase, metrics");
+  command->add_option("--reference", o->reference_file,
+                      "Dense mesh of the true surface: fit the vertices to it (reference mode; fit.h) instead of "
+                      "the paper's flow");
+  command->add_option("--max-rounds", o->fit.max_rounds, "Reference mode: rounds of foot points and solve at most")
+      ->check(CLI::Range(1, 100))
+      ->capture_default_str();
   command->add_option("--html", o->html_file,
                       "Write an HTML report: both meshes in 3D, colour maps, histograms, metrics");
   command->add_flag("--force", o->force, "Allow OUT to be the input file");
   command->callback([o, &global, command, weight, smoothing] {
     const bool unsharp = o->method == "unsharp";
+    const bool fit = !o->reference_file.empty();
+    if (fit && unsharp) throw std::runtime_error("--reference and --method unsharp exclude each other");
+    if (fit) o->method = "reference";
     for (const char* name : {"--lambda", "--mu", "--iterations", "--min-quality", "--no-projection", "--fairness",
-                             "--feature-angle", "--solver"})
+                             "--feature-angle", "--solver", "--sliver-floor"})
       if (unsharp && command->count(name) > 0)
         throw std::runtime_error(std::string(name) + " applies to --method flow only");
+    for (const char* name : {"--lambda", "--mu", "--iterations", "--no-projection", "--fairness", "--feature-angle",
+                             "--solver", "--strict"})
+      if (fit && command->count(name) > 0)
+        throw std::runtime_error(std::string(name) + " does not apply to --reference");
+    if (!fit && command->count("--max-rounds") > 0)
+      throw std::runtime_error("--max-rounds applies to --reference only");
     if (!unsharp && (weight->count() > 0 || smoothing->count() > 0))
       throw std::runtime_error("--weight and --smoothing-iterations apply to --method unsharp only");
-    check_outputs({o->input},
-                  {{o->output, /*mesh=*/true, /*may_replace_input=*/true}, {o->report_file}, {o->html_file}}, o->force);
+    std::vector<std::filesystem::path> inputs{o->input};
+    if (fit) inputs.emplace_back(o->reference_file);
+    check_outputs(inputs, {{o->output, /*mesh=*/true, /*may_replace_input=*/true}, {o->report_file}, {o->html_file}},
+                  o->force);
     if (!o->pin_file.empty()) check_pin_file(o->pin_file);
     auto phase = [&](const std::string& what) {
       if (!global.quiet) fmt::print(stderr, "vertexflow: {}\n", what);
@@ -281,8 +325,20 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     o->flow.project_to_input = !o->no_projection;
     o->unsharp.fix_boundary = o->flow.fix_boundary;
     o->unsharp.pinned = o->flow.pinned;
+    o->fit.fix_boundary = o->flow.fix_boundary;
+    o->fit.pinned = o->flow.pinned;
+    o->fit.min_quality = o->flow.min_quality;
+    o->fit.sliver_floor = o->flow.sliver_floor;
+    Mesh reference;
+    if (fit) {
+      phase("reading " + o->reference_file);
+      reference = read_mesh_with_warnings(o->reference_file, global);
+    }
 
-    if (unsharp)
+    if (fit)
+      phase(fmt::format("fitting {} vertices to {} ({} faces)", mesh.num_vertices(), o->reference_file,
+                        reference.num_faces()));
+    else if (unsharp)
       phase(fmt::format("unsharp mask on {} vertices (weight {}, {} smoothing iterations)", mesh.num_vertices(),
                         o->unsharp.weight, o->unsharp.smoothing_iterations));
     else
@@ -293,7 +349,9 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     Topology topology;
     MethodRun run;
     try {
-      if (unsharp) {
+      if (fit) {
+        run = run_reference(mesh, reference, o->fit, phase);
+      } else if (unsharp) {
         run = run_unsharp(mesh, o->unsharp);
       } else {
         topology = build_topology(mesh.F, mesh.num_vertices());
@@ -315,7 +373,7 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     const double seconds_write = seconds_since(start);
 
     if (!o->report_file.empty() || !o->html_file.empty()) {
-      if (unsharp) topology = build_topology(mesh.F, mesh.num_vertices());
+      if (unsharp || fit) topology = build_topology(mesh.F, mesh.num_vertices());
       // Each mesh's curvature, computed once for the metrics and the HTML report.
       const ReportCurvatures curvatures = report_curvatures(mesh, out, topology);
       nlohmann::json report = flow_metrics(mesh, out, topology, curvatures);
@@ -325,6 +383,20 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
       report["method"] = o->method;
       report["input"] = o->input;
       report["output"] = o->output;
+      if (fit) {
+        report["reference"] = o->reference_file;
+        // Two-sided, as issue 16 measures: the mean of both one-sided means, the RMS over both
+        // directions, and the Hausdorff distance, in the meshes' units.
+        auto two_sided = [&](const Mesh& m) {
+          const SymmetricDistance d = symmetric_distance(m.V, m.F, reference.V, reference.F);
+          return nlohmann::json{{"mean", 0.5 * (d.a_to_b.mean + d.b_to_a.mean)},
+                                {"rms", std::sqrt(0.5 * (d.a_to_b.rms * d.a_to_b.rms + d.b_to_a.rms * d.b_to_a.rms))},
+                                {"hausdorff", d.hausdorff},
+                                {"to_reference", to_json(d.a_to_b, 1.0)},
+                                {"from_reference", to_json(d.b_to_a, 1.0)}};
+        };
+        report["distance_to_reference"] = {{"input", two_sided(mesh)}, {"result", two_sided(out)}};
+      }
       if (!o->report_file.empty()) {
         write_text_file(o->report_file, report.dump(2) + "\n");
         phase("report written to " + o->report_file);

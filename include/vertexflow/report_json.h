@@ -13,6 +13,7 @@
 #pragma once
 
 #include "vertexflow/curvature.h"
+#include "vertexflow/fit.h"
 #include "vertexflow/flow.h"
 #include "vertexflow/flow_energy.h"
 #include "vertexflow/unsharp.h"
@@ -58,5 +59,13 @@ void to_json(nlohmann::json& j, const UnsharpOptions& options);
 
 /// {fixed_vertices}: what the baseline reports besides its positions V (not written).
 void to_json(nlohmann::json& j, const UnsharpResult& result);
+
+/// Every field of FitOptions (pinned as its count).
+void to_json(nlohmann::json& j, const FitOptions& options);
+
+/// The fit's rounds: rms_distance (one entry per round and the start, in the meshes' units),
+/// rounds, converged, reference_samples, the guard's counts (under "guard", as the flow's) and
+/// the seconds per phase (under "seconds").
+void to_json(nlohmann::json& j, const FitReport& report);
 
 }  // namespace vertexflow

@@ -105,4 +105,34 @@ void to_json(nlohmann::json& j, const UnsharpResult& result) {
   j = {{"fixed_vertices", result.fixed_vertices}};
 }
 
+void to_json(nlohmann::json& j, const FitOptions& options) {
+  j = {{"samples_per_vertex", options.samples_per_vertex},
+       {"mesh_to_reference_weight", options.mesh_to_reference_weight},
+       {"fairness", options.fairness},
+       {"proximity", options.proximity},
+       {"max_rounds", options.max_rounds},
+       {"tolerance", options.tolerance},
+       {"fix_boundary", options.fix_boundary},
+       {"pinned", options.pinned.size()},
+       {"min_quality", options.min_quality},
+       {"sliver_floor", options.sliver_floor},
+       {"seed", options.seed}};
+}
+
+void to_json(nlohmann::json& j, const FitReport& report) {
+  j = {{"rms_distance", report.rms_distance},
+       {"rounds", report.rounds},
+       {"converged", report.converged},
+       {"reference_samples", report.reference_samples},
+       {"guard",
+        {{"faces_bad_before_guard", report.flipped_before_guard},
+         {"faces_low_quality_before_guard", report.low_quality_before_guard},
+         {"limited_vertices", report.limited_vertices}}},
+       {"seconds",
+        {{"tree", report.seconds_tree},
+         {"queries", report.seconds_queries},
+         {"solve", report.seconds_solve},
+         {"guard", report.seconds_guard}}}};
+}
+
 }  // namespace vertexflow

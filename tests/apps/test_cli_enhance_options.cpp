@@ -6,12 +6,16 @@
 
 #include "vertexflow/distance.h"
 #include "vertexflow/features.h"
+#include "vertexflow/fit.h"
 #include "vertexflow/flow.h"
 #include "vertexflow/io.h"
 #include "vertexflow/quality.h"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
+#include <algorithm>
+#include <filesystem>
 #include <functional>
 #include <iostream>
 
@@ -123,6 +127,43 @@ TEST(CliEnhanceOptions, SliverFloorBoundsHowFarSliversMayFall) {
       EXPECT_LT(moved, moved_default);
     }
   }
+}
+
+// Reference mode: the CLI's output is fit_to_reference's, the report holds the fit's rounds and
+// both meshes' two-sided distances to the reference, and flow-only options are refused.
+TEST(CliEnhanceOptions, ReferenceFitsToTheDenseMesh) {
+  const Mesh mesh = read_mesh(test::data_path("sphere_low.off"));
+  const Mesh dense = read_mesh(test::data_path("sphere.off"));
+  test::ScratchDir dir("cli-enhance-reference");
+  const auto out = dir.file("out.ply"), report = dir.file("report.json");
+  const auto r = test::run_cli("--quiet enhance " + test::quoted_data_path("sphere_low.off") + " " + test::quoted(out) +
+                               " --reference " + test::quoted_data_path("sphere.off") + " --max-rounds 3 --report " +
+                               test::quoted(report));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  FitOptions options;
+  options.max_rounds = 3;
+  const FitResult expected = fit_to_reference(mesh.V, mesh.F, dense.V, dense.F, options);
+  EXPECT_EQ(read_mesh(out).V, expected.V);
+  EXPECT_NE(expected.V, mesh.V);
+  const nlohmann::json j = nlohmann::json::parse(test::read_text(report));
+  EXPECT_EQ(j["method"], "reference");
+  EXPECT_EQ(j["fit"]["rounds"], expected.report.rounds);
+  EXPECT_EQ(j["options"]["max_rounds"], 3);
+  EXPECT_EQ(j["fit"]["rms_distance"].size(), expected.report.rms_distance.size());
+  const auto& d = j["distance_to_reference"];
+  for (const char* key : {"mean", "rms"}) EXPECT_LT(d["result"][key], d["input"][key]) << key;
+  for (const std::string bad : {"--lambda 2", "--no-projection", "--strict", "--method unsharp"}) {
+    const auto refused =
+        test::run_cli("enhance " + test::quoted_data_path("sphere_low.off") + " " + test::quoted(dir.file("x.ply")) +
+                      " --reference " + test::quoted_data_path("sphere.off") + " " + bad);
+    EXPECT_EQ(refused.exit_code, 1) << bad;
+    EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("x.ply")));
+  }
+  const auto missing = test::run_cli("enhance " + test::quoted_data_path("sphere_low.off") + " " +
+                                     test::quoted(dir.file("x.ply")) + " --reference /nonexistent/dense.off");
+  EXPECT_EQ(missing.exit_code, 1);
+  EXPECT_NE(missing.err.find("/nonexistent/dense.off"), std::string::npos) << missing.err;
 }
 
 TEST(CliEnhanceOptions, NoProjectionLeavesTheSurface) {
