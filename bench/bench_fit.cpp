@@ -1,0 +1,69 @@
+// fit_to_reference (fit.h), reference mode of issue 16: a 10k-vertex remesh of bunny.off fitted
+// to bunny.off subdivided 1-to-16 (557k vertices, 1.1M faces), the tree over the reference and
+// the sampling included; and the same remesh against bunny.off itself (35k vertices). Counters:
+// rounds and the phases of FitReport in milliseconds per run.
+//
+//   build/bin/bench_fit --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
+#include "bench_support.h"
+
+#include "vertexflow/fit.h"
+#include "vertexflow/io.h"
+#include "vertexflow/remesh.h"
+
+#include <benchmark/benchmark.h>
+
+#include <iostream>
+
+namespace vertexflow::bench {
+namespace {
+
+const Mesh& dense_bunny() {
+  static const Mesh mesh = read_mesh(data_dir() / "bunny.off");
+  return mesh;
+}
+
+const Mesh& coarse_bunny() {
+  static const Mesh mesh = [] {
+    RemeshOptions options;
+    options.target_vertices = 10000;
+    return remesh_to_vertex_count(dense_bunny().V, dense_bunny().F, options).mesh;
+  }();
+  return mesh;
+}
+
+const Mesh& subdivided_bunny() {
+  static const Mesh mesh = subdivide_uniform(dense_bunny(), 4);
+  return mesh;
+}
+
+void run(benchmark::State& state, const Mesh& reference) {
+  const Mesh& coarse = coarse_bunny();
+  FitReport report;
+  for (auto _ : state) {
+    FitResult result = fit_to_reference(coarse.V, coarse.F, reference.V, reference.F);
+    benchmark::DoNotOptimize(result.V.data());
+    report = result.report;
+  }
+  state.counters["vertices"] = static_cast<double>(coarse.num_vertices());
+  state.counters["reference_vertices"] = static_cast<double>(reference.num_vertices());
+  state.counters["rounds"] = report.rounds;
+  state.counters["tree_ms"] = 1e3 * report.seconds_tree;
+  state.counters["queries_ms"] = 1e3 * report.seconds_queries;
+  state.counters["solve_ms"] = 1e3 * report.seconds_solve;
+  state.counters["guard_ms"] = 1e3 * report.seconds_guard;
+}
+
+void BM_FitTo557k(benchmark::State& state) {
+  run(state, subdivided_bunny());
+}
+void BM_FitTo35k(benchmark::State& state) {
+  run(state, dense_bunny());
+}
+
+BENCHMARK(BM_FitTo557k)->Name("fit/bunny-10k/reference-557k")->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_FitTo35k)->Name("fit/bunny-10k/reference-35k")->Unit(benchmark::kMillisecond)->UseRealTime();
+
+}  // namespace
+}  // namespace vertexflow::bench
+
+BENCHMARK_MAIN();
