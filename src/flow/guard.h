@@ -31,7 +31,7 @@ GuardCriteria guard_criteria(const Vertices& before, const Faces& F, double min_
 /// helps that face most; a shortened vertex is projected back onto the input (when
 /// options.project_to_input), and at its max_halvings-th halving it is at its anchor. Then
 /// passes offer the vertices left short their whole move again from where they are, until a
-/// pass brings none to its target. Counts the bad faces of X in report (summed over rounds) and
+/// pass brings fewer than 2% of them to their targets. Counts the bad faces of X in report (summed over rounds) and
 /// marks the vertices that end short of their move in X.
 void guard(Vertices& X, const Vertices& anchor, const Vertices& input, const GuardCriteria& criteria,
            const std::vector<char>& fixed, const Topology& topology, const SurfaceFeatures& features,
