@@ -7,6 +7,10 @@
 
 #include <fmt/format.h>
 
+#include <fcntl.h>
+#include <pthread.h>
+#include <sys/stat.h>
+#include <unistd.h>
 #include <algorithm>
 #include <array>
 #include <atomic>
@@ -15,9 +19,6 @@
 #include <cstdlib>
 #include <mutex>
 #include <random>
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 namespace vertexflow {
 namespace io_detail {
@@ -151,12 +152,18 @@ class AtomicFile {
     for (int attempt = 0; attempt < 100 && fd_ < 0; ++attempt) {
       temp_ = random_hidden_name(target_);
       slot_ = TemporaryRegistry::reserve(temp_);
+      // SIGINT and SIGTERM wait while the file is created and armed: a signal between the two
+      // left the file behind (seen once in CI, killed right as the write began).
+      sigset_t creating, before;
+      sigemptyset(&creating);
+      sigaddset(&creating, SIGINT);
+      sigaddset(&creating, SIGTERM);
+      ::pthread_sigmask(SIG_BLOCK, &creating, &before);
       fd_ = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
       const int error = errno;
-      if (fd_ >= 0) {
-        TemporaryRegistry::arm(slot_);
-        break;
-      }
+      if (fd_ >= 0) TemporaryRegistry::arm(slot_);
+      ::pthread_sigmask(SIG_SETMASK, &before, nullptr);
+      if (fd_ >= 0) break;
       TemporaryRegistry::release(slot_);
       slot_ = TemporaryRegistry::kNone;
       temp_.clear();
@@ -235,7 +242,8 @@ class AtomicFile {
 class Output {
  public:
   Output(const std::filesystem::path& path, bool gzip) : file_(path), gzip_(gzip), name_(path.string()) {
-    if (gzip_ && deflateInit2(&stream_, Z_DEFAULT_COMPRESSION, Z_DEFLATED, 16 + MAX_WBITS, 8, Z_DEFAULT_STRATEGY) != Z_OK)
+    if (gzip_ &&
+        deflateInit2(&stream_, Z_DEFAULT_COMPRESSION, Z_DEFLATED, 16 + MAX_WBITS, 8, Z_DEFAULT_STRATEGY) != Z_OK)
       fail(name_, "cannot initialise gzip encoder");
     buffer_.reserve(kChunk + 4096);
   }
@@ -375,12 +383,12 @@ void write_ply(Output& out, const std::string& name, const Mesh& mesh, const Wri
   }
   const char* coordinate = options.ply_double_precision ? "double" : "float";
   b += "ply\nformat ";
-  b += options.ply_encoding == PlyEncoding::Ascii ? "ascii"
+  b += options.ply_encoding == PlyEncoding::Ascii             ? "ascii"
        : options.ply_encoding == PlyEncoding::BinaryBigEndian ? "binary_big_endian"
                                                               : "binary_little_endian";
   b += " 1.0\ncomment written by vertexflow\n";
-  b += fmt::format("element vertex {}\nproperty {} x\nproperty {} y\nproperty {} z\n", mesh.num_vertices(),
-                   coordinate, coordinate, coordinate);
+  b += fmt::format("element vertex {}\nproperty {} x\nproperty {} y\nproperty {} z\n", mesh.num_vertices(), coordinate,
+                   coordinate, coordinate);
   if (colors) b += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
   for (const auto* p : properties) b += fmt::format("property double {}\n", p->name);
   b += fmt::format("element face {}\nproperty list uchar int vertex_indices\nend_header\n", mesh.num_faces());
@@ -405,8 +413,10 @@ void write_ply(Output& out, const std::string& name, const Mesh& mesh, const Wri
   const bool swap = (options.ply_encoding == PlyEncoding::BinaryBigEndian) == host_is_little_endian();
   for (Index v = 0; v < mesh.num_vertices(); ++v) {
     for (int c = 0; c < 3; ++c) {
-      if (options.ply_double_precision) store_scalar<double>(b, mesh.V(v, c), swap);
-      else store_scalar<float>(b, static_cast<float>(mesh.V(v, c)), swap);
+      if (options.ply_double_precision)
+        store_scalar<double>(b, mesh.V(v, c), swap);
+      else
+        store_scalar<float>(b, static_cast<float>(mesh.V(v, c)), swap);
     }
     if (colors) b.append(reinterpret_cast<const char*>(mesh.colors.row(v).data()), 3);
     for (const auto* p : properties) store_scalar<double>(b, p->values[v], swap);
@@ -473,10 +483,18 @@ void write_mesh(const std::filesystem::path& path, const Mesh& mesh, const Write
   if (std::filesystem::is_directory(path, ec)) io_detail::fail(name, "is a directory");
   io_detail::Output out(path, is_gzip_path(path));
   switch (format) {
-    case MeshFormat::Obj: io_detail::write_obj(out, mesh); break;
-    case MeshFormat::Ply: io_detail::write_ply(out, name, mesh, options); break;
-    case MeshFormat::Off: io_detail::write_off(out, mesh, options); break;
-    case MeshFormat::Stl: io_detail::write_stl(out, mesh, options); break;
+    case MeshFormat::Obj:
+      io_detail::write_obj(out, mesh);
+      break;
+    case MeshFormat::Ply:
+      io_detail::write_ply(out, name, mesh, options);
+      break;
+    case MeshFormat::Off:
+      io_detail::write_off(out, mesh, options);
+      break;
+    case MeshFormat::Stl:
+      io_detail::write_stl(out, mesh, options);
+      break;
   }
   out.commit();
 }
