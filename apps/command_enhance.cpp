@@ -389,8 +389,8 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
         // directions, and the Hausdorff distance, in the meshes' units.
         auto two_sided = [&](const Mesh& m) {
           const SymmetricDistance d = symmetric_distance(m.V, m.F, reference.V, reference.F);
-          return nlohmann::json{{"mean", 0.5 * (d.a_to_b.mean + d.b_to_a.mean)},
-                                {"rms", std::sqrt(0.5 * (d.a_to_b.rms * d.a_to_b.rms + d.b_to_a.rms * d.b_to_a.rms))},
+          return nlohmann::json{{"mean", d.mean()},
+                                {"rms", d.rms()},
                                 {"hausdorff", d.hausdorff},
                                 {"to_reference", to_json(d.a_to_b, 1.0)},
                                 {"from_reference", to_json(d.b_to_a, 1.0)}};

@@ -27,8 +27,7 @@ TwoSided two_sided(const Vertices& V, const Faces& F, const Mesh& reference) {
   SamplingOptions sampling;
   sampling.samples = 200000;
   const SymmetricDistance d = symmetric_distance(V, F, reference.V, reference.F, sampling);
-  return {0.5 * (d.a_to_b.mean + d.b_to_a.mean),
-          std::sqrt(0.5 * (d.a_to_b.rms * d.a_to_b.rms + d.b_to_a.rms * d.b_to_a.rms)), d.hausdorff};
+  return {d.mean(), d.rms(), d.hausdorff};
 }
 
 }  // namespace

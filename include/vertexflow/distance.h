@@ -135,6 +135,10 @@ struct SymmetricDistance {
   [[nodiscard]] SymmetricDistance relative_to(double length) const {
     return {a_to_b.relative_to(length), b_to_a.relative_to(length), hausdorff / length};
   }
+  /// Two-sided figures: the mean of the two one-sided means, and the RMS over both directions
+  /// (sqrt of the mean of the two mean squares).
+  [[nodiscard]] double mean() const { return 0.5 * (a_to_b.mean + b_to_a.mean); }
+  [[nodiscard]] double rms() const;
 };
 
 /// A -> B and B -> A with the same sampling options for both.

@@ -319,7 +319,8 @@ Eigen::VectorXd DistanceQuery::squared_distances(const Vertices& P) const {
 }
 
 double DistanceQuery::max_squared_distance(const Vertices& P, Index first_row, double at_least) const {
-  if (first_row < 0 || first_row > P.rows()) throw std::invalid_argument("max_squared_distance: first row out of range");
+  if (first_row < 0 || first_row > P.rows())
+    throw std::invalid_argument("max_squared_distance: first row out of range");
   const auto first = static_cast<std::size_t>(first_row), last = static_cast<std::size_t>(P.rows());
   // One slot per block (a block runs on one thread at a time); the maximum does not depend on
   // the order of the slots.
@@ -375,6 +376,10 @@ SymmetricDistance symmetric_distance(const Vertices& VA, const Faces& FA, const 
   tbb::parallel_invoke([&] { a_to_b = one_sided_distance(VA, FA, VB, FB, options); },
                        [&] { b_to_a = one_sided_distance(VB, FB, VA, FA, options); });
   return symmetric_distance(a_to_b, b_to_a);
+}
+
+double SymmetricDistance::rms() const {
+  return std::sqrt(0.5 * (a_to_b.rms * a_to_b.rms + b_to_a.rms * b_to_a.rms));
 }
 
 }  // namespace vertexflow

@@ -30,26 +30,13 @@ TwoSided two_sided(const Vertices& V, const Faces& F, const Mesh& reference) {
   SamplingOptions sampling;
   sampling.samples = 100000;
   const SymmetricDistance d = symmetric_distance(V, F, reference.V, reference.F, sampling);
-  return {0.5 * (d.a_to_b.mean + d.b_to_a.mean),
-          std::sqrt(0.5 * (d.a_to_b.rms * d.a_to_b.rms + d.b_to_a.rms * d.b_to_a.rms)), d.hausdorff};
+  return {d.mean(), d.rms(), d.hausdorff};
 }
 
 // The promises of fit.h on any input.
 void expect_promises_kept(const Mesh& mesh, const FitResult& result, const FitOptions& options) {
-  ASSERT_EQ(result.V.rows(), mesh.V.rows());
-  ASSERT_TRUE(result.V.allFinite());
-  EXPECT_TRUE(flipped_faces(mesh.V, result.V, mesh.F).empty());
-  EXPECT_TRUE(degenerate_faces(result.V, mesh.F).empty());
-  const Topology topology = build_topology(mesh.F, mesh.num_vertices());
-  for (Index v = 0; v < mesh.num_vertices(); ++v) {
-    if (options.fix_boundary && topology.is_boundary_vertex[static_cast<std::size_t>(v)]) {
-      ASSERT_EQ(result.V.row(v), mesh.V.row(v)) << v;
-    }
-  }
-  for (const Index v : options.pinned) ASSERT_EQ(result.V.row(v), mesh.V.row(v)) << v;
-  const Eigen::VectorXd floor = test::stated_quality_floor(mesh, options.min_quality, options.sliver_floor);
-  const Eigen::VectorXd q = triangle_quality(result.V, mesh.F);
-  for (Index f = 0; f < mesh.num_faces(); ++f) ASSERT_GE(q[f], floor[f] - 1e-12) << "face " << f;
+  test::expect_guard_promises_kept(mesh, result.V, options.fix_boundary, options.pinned, options.min_quality,
+                                   options.sliver_floor);
   // The stopping rule: the RMS falls every round, and the rounds stop once the data energy
   // (RMS squared) falls by less than the tolerance, or at max_rounds.
   const auto& rms = result.report.rms_distance;

@@ -66,19 +66,8 @@ std::ostream& operator<<(std::ostream& out, const FlowExpectation& e) {
 // FlowOptions::min_quality states (exactly: up to the rounding of mapping the normalised result
 // back).
 void expect_promises_kept(const Mesh& mesh, const FlowResult& result, const FlowOptions& options = {}) {
-  ASSERT_TRUE(result.V.allFinite());
-  EXPECT_TRUE(flipped_faces(mesh.V, result.V, mesh.F).empty());
-  EXPECT_TRUE(degenerate_faces(result.V, mesh.F).empty());
-  const Topology topology = build_topology(mesh.F, mesh.num_vertices());
-  for (Index v = 0; v < mesh.num_vertices(); ++v) {
-    if (options.fix_boundary && topology.is_boundary_vertex[static_cast<std::size_t>(v)]) {
-      ASSERT_EQ(result.V.row(v), mesh.V.row(v)) << v;
-    }
-  }
-  for (const Index v : options.pinned) ASSERT_EQ(result.V.row(v), mesh.V.row(v)) << v;
-  const Eigen::VectorXd floor = test::stated_quality_floor(mesh, options.min_quality, options.sliver_floor);
-  const Eigen::VectorXd q_out = triangle_quality(result.V, mesh.F);
-  for (Index f = 0; f < mesh.num_faces(); ++f) ASSERT_GE(q_out[f], floor[f] - 1e-12) << "face " << f;
+  test::expect_guard_promises_kept(mesh, result.V, options.fix_boundary, options.pinned, options.min_quality,
+                                   options.sliver_floor);
 }
 
 // The promises, then the effect one flow at `options` must have on `mesh` (expectation).

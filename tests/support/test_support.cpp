@@ -145,6 +145,24 @@ Eigen::VectorXd stated_quality_floor(const Mesh& input, double min_quality, doub
   return floor;
 }
 
+void expect_guard_promises_kept(const Mesh& input, const Vertices& moved, bool fix_boundary,
+                                const std::vector<Index>& pinned, double min_quality, double sliver_floor) {
+  ASSERT_EQ(moved.rows(), input.V.rows());
+  ASSERT_TRUE(moved.allFinite());
+  EXPECT_TRUE(flipped_faces(input.V, moved, input.F).empty());
+  EXPECT_TRUE(degenerate_faces(moved, input.F).empty());
+  const Topology topology = build_topology(input.F, input.num_vertices());
+  for (Index v = 0; v < input.num_vertices(); ++v) {
+    if (fix_boundary && topology.is_boundary_vertex[static_cast<std::size_t>(v)]) {
+      ASSERT_EQ(moved.row(v), input.V.row(v)) << v;
+    }
+  }
+  for (const Index v : pinned) ASSERT_EQ(moved.row(v), input.V.row(v)) << v;
+  const Eigen::VectorXd floor = stated_quality_floor(input, min_quality, sliver_floor);
+  const Eigen::VectorXd q = triangle_quality(moved, input.F);
+  for (Index f = 0; f < input.num_faces(); ++f) ASSERT_GE(q[f], floor[f] - 1e-12) << "face " << f;
+}
+
 void expect_clean_surface(const Mesh& mesh) {
   const Topology topology = build_topology(mesh.F, mesh.num_vertices());
   EXPECT_TRUE(topology.is_manifold()) << describe_non_manifold(topology);

@@ -89,6 +89,12 @@ inline std::string quoted_data_path(const std::string& name) {
 /// loops as `input` (gtest assertions).
 void expect_same_topology(const Mesh& input, const Mesh& output);
 
+/// Expects the guard's promises (flow.h, fit.h) of `moved` (new positions for input.F): finite,
+/// no face flipped or degenerate, boundary vertices (when fix_boundary) and `pinned` vertices
+/// bit for bit where they were, every face at or above stated_quality_floor (up to 1e-12).
+void expect_guard_promises_kept(const Mesh& input, const Vertices& moved, bool fix_boundary,
+                                const std::vector<Index>& pinned, double min_quality, double sliver_floor);
+
 /// Expects what remesh.h and simplify.h promise of their output, and what the flow needs to
 /// take it with FlowOptions::refuse_non_manifold: manifold, consistently oriented, no face of
 /// zero area (degenerate_faces), no unreferenced vertex.
