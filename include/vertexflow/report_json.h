@@ -63,9 +63,9 @@ void to_json(nlohmann::json& j, const UnsharpResult& result);
 /// Every field of FitOptions (pinned as its count).
 void to_json(nlohmann::json& j, const FitOptions& options);
 
-/// The fit's rounds: rms_distance (one entry per round and the start, in the meshes' units),
-/// rounds, converged, reference_samples, the guard's counts (under "guard", as the flow's) and
-/// the seconds per phase (under "seconds").
+/// Three sections, as the enhance report has them: "fit" (rms_distance, one entry for the start
+/// and one per round, in the meshes' units; rounds; converged; reference_samples), "guard" (the
+/// guard's counts, as the flow's) and "seconds" (per phase).
 void to_json(nlohmann::json& j, const FitReport& report);
 
 }  // namespace vertexflow

@@ -169,11 +169,11 @@ GuardCriteria guard_criteria(const Vertices& before, const Faces& F, double min_
 void guard(Vertices& X, const Vertices& anchor, const Vertices& input, const GuardCriteria& criteria,
            const std::vector<char>& fixed, const Topology& topology, const SurfaceFeatures& features,
            const FlowOptions& options, std::vector<char>& shortened, FlowReport& report) {
-  const Vertices target = X;
   std::vector<char> bad = bad_faces(criteria, X);
   report.flipped_before_guard += static_cast<Index>(std::count(bad.begin(), bad.end(), kFlippedOrDegenerate));
   report.low_quality_before_guard += static_cast<Index>(std::count(bad.begin(), bad.end(), kLowQuality));
   if (std::none_of(bad.begin(), bad.end(), [](char b) { return b != 0; })) return;
+  const Vertices target = X;
   const auto n = static_cast<std::size_t>(X.rows());
   std::vector<Index> bad_list;
   for (Index f = 0; f < criteria.F.rows(); ++f) {

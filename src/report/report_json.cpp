@@ -120,10 +120,11 @@ void to_json(nlohmann::json& j, const FitOptions& options) {
 }
 
 void to_json(nlohmann::json& j, const FitReport& report) {
-  j = {{"rms_distance", report.rms_distance},
-       {"rounds", report.rounds},
-       {"converged", report.converged},
-       {"reference_samples", report.reference_samples},
+  j = {{"fit",
+        {{"rms_distance", report.rms_distance},
+         {"rounds", report.rounds},
+         {"converged", report.converged},
+         {"reference_samples", report.reference_samples}}},
        {"guard",
         {{"faces_bad_before_guard", report.flipped_before_guard},
          {"faces_low_quality_before_guard", report.low_quality_before_guard},
