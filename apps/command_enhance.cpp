@@ -153,6 +153,15 @@ struct MethodRun {
 
 using Progress = std::function<void(const std::string&)>;
 
+// One warning line for a mesh that was run as its manifold split (manifold_split.h).
+void warn_about_split(const ManifoldSplitCounts& split, const Progress& warn) {
+  if (split.any())
+    warn(
+        fmt::format("the mesh is not manifold or not consistently oriented: {} vertices held (their faces form more "
+                    "than one fan), {} faces reoriented, {} edges treated as boundaries; --strict refuses such meshes",
+                    split.held_vertices, split.reversed_faces, split.cut_edges));
+}
+
 // The flow, with the caller's topology of mesh.F. Report: options, solver, guard, seconds.
 MethodRun run_flow(const Mesh& mesh, const Topology& topology, const FlowOptions& options, const Progress& phase,
                    const Progress& warn) {
@@ -163,11 +172,7 @@ MethodRun run_flow(const Mesh& mesh, const Topology& topology, const FlowOptions
       "limited by the guard",
       r.seconds_curvature, r.seconds_assembly, r.seconds_solve, r.seconds_projection, r.seconds_guard,
       r.limited_vertices));
-  if (r.held_non_manifold_vertices + r.reoriented_faces + r.cut_edges > 0)
-    warn(
-        fmt::format("the mesh is not manifold or not consistently oriented: {} vertices held (their faces form more "
-                    "than one fan), {} faces reoriented, {} edges treated as boundaries; --strict refuses such meshes",
-                    r.held_non_manifold_vertices, r.reoriented_faces, r.cut_edges));
+  warn_about_split({r.held_non_manifold_vertices, r.reoriented_faces, r.cut_edges}, warn);
   MethodRun run;
   run.report = r;
   run.report["options"] = options;
@@ -193,10 +198,11 @@ MethodRun run_reference(const Mesh& mesh, const Mesh& reference, const FitOption
 }
 
 // The unsharp-mask baseline (unsharp.h). Report: options, fixed_vertices, seconds.
-MethodRun run_unsharp(const Mesh& mesh, const UnsharpOptions& options) {
+MethodRun run_unsharp(const Mesh& mesh, const UnsharpOptions& options, const Progress& warn) {
   const auto start = Clock::now();
   UnsharpResult result = unsharp_mask(mesh.V, mesh.F, options);
   const double seconds = seconds_since(start);
+  warn_about_split(result.non_manifold, warn);
   MethodRun run;
   run.report = result;
   run.report["options"] = options;
@@ -210,7 +216,7 @@ MethodRun run_unsharp(const Mesh& mesh, const UnsharpOptions& options) {
 void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
   auto o = std::make_shared<EnhanceOptions>();
   CLI::App* command = app.add_subcommand("enhance", "Enhance shape features by vertex flow (Ji et al. 2011)");
-  command->add_option("IN", o->input, "Input mesh (manifold)")->required();
+  command->add_option("IN", o->input, "Input mesh")->required();
   command->add_option("OUT", o->output, "Output mesh (same connectivity)")->required();
   command
       ->add_option("--lambda", o->flow.weights.lambda,
@@ -233,6 +239,12 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
       ->add_option("--sliver-floor", o->flow.sliver_floor,
                    "Guard: a face starting below --min-quality may not fall below this fraction of its input ratio")
       ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  command
+      ->add_option("--sliver-stiffness", o->flow.weights.sliver,
+                   "Weight of the solve's term that keeps corners of faces below --min-quality from their opposite "
+                   "edges (0: the guard alone)")
+      ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
   command->add_flag("--no-projection", o->no_projection,
                     "Leave vertices where the solve puts them instead of moving them onto the input surface");
@@ -288,11 +300,11 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     if (fit && unsharp) throw std::runtime_error("--reference and --method unsharp exclude each other");
     if (fit) o->method = "reference";
     for (const char* name : {"--lambda", "--mu", "--iterations", "--min-quality", "--no-projection", "--fairness",
-                             "--feature-angle", "--solver", "--sliver-floor"})
+                             "--feature-angle", "--solver", "--sliver-floor", "--sliver-stiffness"})
       if (unsharp && command->count(name) > 0)
         throw std::runtime_error(std::string(name) + " applies to --method flow only");
     for (const char* name : {"--lambda", "--mu", "--iterations", "--no-projection", "--fairness", "--feature-angle",
-                             "--solver", "--strict"})
+                             "--solver", "--strict", "--sliver-stiffness"})
       if (fit && command->count(name) > 0)
         throw std::runtime_error(std::string(name) + " does not apply to --reference");
     if (!fit && command->count("--max-rounds") > 0)
@@ -319,6 +331,7 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     o->flow.project_to_input = !o->no_projection;
     o->unsharp.fix_boundary = o->flow.fix_boundary;
     o->unsharp.pinned = o->flow.pinned;
+    o->unsharp.refuse_non_manifold = o->flow.refuse_non_manifold;
     o->fit.fix_boundary = o->flow.fix_boundary;
     o->fit.pinned = o->flow.pinned;
     o->fit.min_quality = o->flow.min_quality;
@@ -346,7 +359,7 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
       if (fit) {
         run = run_reference(mesh, reference, o->fit, phase);
       } else if (unsharp) {
-        run = run_unsharp(mesh, o->unsharp);
+        run = run_unsharp(mesh, o->unsharp, warn);
       } else {
         topology = build_topology(mesh.F, mesh.num_vertices());
         run = run_flow(mesh, topology, o->flow, phase, warn);

@@ -67,7 +67,8 @@ enum class LinearSolver {
 
 struct FlowOptions {
   /// The weights of the energy's terms (flow_energy.h): lambda, the user's strength knob
-  /// (default 1), mu (0.5), epsilon (1e-6) and the fairness target (the input's normal part).
+  /// (default 1), mu (0.5), epsilon (1e-6), the fairness target (the input's normal part) and
+  /// sliver (0.02), the weight of the term that keeps slivers from flipping in the solve.
   EnergyWeights weights;
   /// d of Eq. 6 is the principal curvature radius at this percentile of |k| (largest
   /// curvatures). 100 is the paper's literal "minimum radius of all vertices", which a single
@@ -115,10 +116,11 @@ struct FlowOptions {
   /// input face around it), except that slivers (faces starting below min_quality) may lose
   /// up to the fraction 1 - sliver_floor of their quality. A face may thus get worse than it
   /// started as long as the worst face it touches does not: the earlier rule (no face below
-  /// its own input quality) froze sliver-heavy meshes (a thin genus-121 plate with 75% of its
-  /// faces below 0.3: 89% of the vertices shortened, rho +0.00; now rho +0.30). The solve
-  /// itself has no quality term; without the floor, CAD creases produced 0.3% (fandisk) to 3%
-  /// (spot) of faces below 0.3. 0 disables it (only flipped and degenerate faces are repaired).
+  /// its own input quality) froze sliver-heavy meshes (a thin genus-121 plate with 63% of its
+  /// faces below 0.3: 89% of the vertices shortened, rho +0.00; now, with the solve's sliver
+  /// term of flow_energy.h, 17.5% shortened and rho +0.13). The solve keeps no quality floor
+  /// itself; without the floor, CAD creases produced 0.3% (fandisk) to 3% (spot) of faces
+  /// below 0.3. The faces below min_quality are also the slivers of F_sliver. 0 disables it (only flipped and degenerate faces are repaired).
   double min_quality = 0.3;
   /// See min_quality: the fraction of its input quality below which a sliver (a face that
   /// starts below min_quality) may not fall. 1 keeps every sliver at least as good as its
@@ -161,8 +163,8 @@ struct FlowResult {
   FlowReport report;
 };
 
-/// Checks every option against its allowed range: lambda > 0, mu >= 0, epsilon > 0 (all
-/// finite), d_percentile in [0, 100], iterations >= 1, feature_angle >= 0, max_halvings >= 1,
+/// Checks every option against its allowed range: lambda > 0, mu >= 0, epsilon > 0, sliver >= 0
+/// (all finite), d_percentile in [0, 100], iterations >= 1, feature_angle >= 0, max_halvings >= 1,
 /// min_quality and sliver_floor in [0, 1], solver_tolerance in (0, 1), curvature.smoothing_rounds >= 0, and
 /// (when num_vertices >= 0) every pinned index in [0, num_vertices). Throws
 /// std::invalid_argument naming the first option out of range and its allowed range.

@@ -18,9 +18,14 @@
 //   once and each neighbour once per shared face, and moves boundary vertices along the
 //   boundary; here S is the plain one-ring mean with fixed boundary, as in the Laplacian used
 //   by the paper's other terms. MeshLab's "original weight" is fixed at 1.
-// - Input: a manifold mesh (topology.h); std::invalid_argument otherwise, as for the flow.
+// - Non-manifold input, as for the flow (flow.h): the mesh is smoothed as its manifold split
+//   (manifold_split.h), whose cut edges are boundaries, with the vertices that have several
+//   copies held bit for bit. The smoothing needs no orientation, so a manifold mesh whose
+//   faces disagree in orientation is smoothed as it is. refuse_non_manifold keeps the old
+//   refusal.
 #pragma once
 
+#include "vertexflow/manifold_split.h"
 #include "vertexflow/mesh.h"
 
 #include <vector>
@@ -36,16 +41,21 @@ struct UnsharpOptions {
   bool fix_boundary = true;
   /// Vertices held in place (indices into V).
   std::vector<Index> pinned;
+  /// Refuse (std::invalid_argument) a non-manifold mesh instead of smoothing its manifold
+  /// split (the CLI's --strict).
+  bool refuse_non_manifold = false;
 };
 
 struct UnsharpResult {
   Vertices V;                ///< new positions; faces are unchanged
-  Index fixed_vertices = 0;  ///< boundary, pinned and isolated vertices
+  Index fixed_vertices = 0;  ///< boundary, pinned, isolated and held non-manifold vertices
+  /// Non-manifold input: what its manifold split held and cut (reversed_faces is always 0).
+  ManifoldSplitCounts non_manifold;
 };
 
-/// Applies the unsharp mask to (V, F). Throws std::invalid_argument for an empty or
-/// non-manifold mesh, a negative iteration count, a non-finite weight or a pinned index out of
-/// range.
+/// Applies the unsharp mask to (V, F). Throws std::invalid_argument for an empty mesh, a
+/// non-manifold one with refuse_non_manifold, a negative iteration count, a non-finite weight
+/// or a pinned index out of range.
 UnsharpResult unsharp_mask(const Vertices& V, const Faces& F, const UnsharpOptions& options = {});
 
 }  // namespace vertexflow

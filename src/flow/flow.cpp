@@ -26,6 +26,7 @@ void validate_flow_options(const FlowOptions& o, Index num_vertices) {
   require(std::isfinite(w.lambda) && w.lambda > 0, "lambda must be a finite number > 0");
   require(std::isfinite(w.mu) && w.mu >= 0, "mu must be a finite number >= 0");
   require(std::isfinite(w.epsilon) && w.epsilon > 0, "epsilon must be a finite number > 0");
+  require(std::isfinite(w.sliver) && w.sliver >= 0, "sliver must be a finite number >= 0");
   require(o.d_percentile >= 0 && o.d_percentile <= 100, "d_percentile must be in [0, 100]");
   require(o.iterations >= 1, "iterations must be at least 1");
   require(o.feature_angle >= 0, "feature_angle must be >= 0 degrees (180 or more disables creases)");
@@ -120,7 +121,7 @@ FlowResult vertex_flow(const Vertices& V, const Faces& F, const Topology& topolo
     const Vertices start_of_round = X;
     // One solve: minimise the energy for positions X, frozen curvature of X.
     auto start = Clock::now();
-    const FlowFrame frame = flow_frame(X, F, topology, options);
+    const FlowFrame frame = flow_frame(X, F, topology, options, setup.sliver_faces);
     report.d = frame.d;
     report.seconds_curvature += seconds_since(start);
     X = solver.solve(frame, options.weights, report);

@@ -95,13 +95,23 @@ double fairness_energy(const Vertices& V, const Topology& topology, const FlowFr
   return V.rows() > 0 ? sum / static_cast<double>(V.rows()) : 0.0;
 }
 
+double sliver_energy(const Vertices& V, const FlowFrame& frame) {
+  if (frame.sliver_stiffness.empty() || V.rows() == 0) return 0.0;
+  double sum = 0;
+  for (Index i = 0; i < static_cast<Index>(V.rows()); ++i) {
+    const Eigen::Vector3d move = row3(V, i) - row3(frame.P, i);
+    sum += move.dot(frame.sliver_stiffness[static_cast<std::size_t>(i)] * move);
+  }
+  return sum / static_cast<double>(V.rows());
+}
+
 double total_flow_energy(const Vertices& V, const Topology& topology, const FlowFrame& frame,
                          const EnergyWeights& weights) {
   const double n = static_cast<double>(V.rows());
   const double pull = n > 0 ? (V - frame.P).squaredNorm() / n : 0.0;
   return tangential_edge_energy(V, topology, frame) + weights.lambda * squared_distance_energy(V, frame) +
          weights.mu * fairness_energy(V, topology, frame, weights.fairness_target) +
-         weights.epsilon * weights.lambda * pull;
+         weights.sliver * sliver_energy(V, frame) + weights.epsilon * weights.lambda * pull;
 }
 
 }  // namespace vertexflow

@@ -1,5 +1,6 @@
 #include "flow_setup.h"
 
+#include "vertexflow/quality.h"
 #include "vertexflow/statistics.h"
 
 #include <algorithm>
@@ -16,6 +17,28 @@ double robust_radius(const Curvature& c, double at_percentile) {
     k[static_cast<std::size_t>(i)] = std::max(std::abs(c.k1[i]), std::abs(c.k2[i]));
   const double largest = percentile(std::move(k), at_percentile);
   return largest > 0 ? 1.0 / largest : 1.0;
+}
+
+// F_sliver's blocks (flow_energy.h): per corner of each sliver, m m^T / h^2 with m the unit
+// in-plane vector across the opposite edge and h the altitude. A face degenerate at X has no
+// plane and adds nothing (the guard keeps faces from degenerating).
+std::vector<Eigen::Matrix3d> sliver_stiffness(const Vertices& X, const Faces& F, const std::vector<Index>& faces,
+                                              Index num_vertices) {
+  std::vector<Eigen::Matrix3d> stiffness(static_cast<std::size_t>(num_vertices), Eigen::Matrix3d::Zero());
+  for (const Index f : faces) {
+    const Eigen::Vector3d p[3] = {X.row(F(f, 0)).transpose(), X.row(F(f, 1)).transpose(), X.row(F(f, 2)).transpose()};
+    const Eigen::Vector3d normal = (p[1] - p[0]).cross(p[2] - p[0]);
+    const double twice_area = normal.norm();
+    if (!(twice_area > 0)) continue;
+    for (int c = 0; c < 3; ++c) {
+      const Eigen::Vector3d edge = p[(c + 2) % 3] - p[(c + 1) % 3];
+      const double length = edge.norm();
+      const double altitude = twice_area / length;
+      const Eigen::Vector3d across = (normal / twice_area).cross(edge / length);
+      stiffness[static_cast<std::size_t>(F(f, c))] += across * across.transpose() / (altitude * altitude);
+    }
+  }
+  return stiffness;
 }
 
 }  // namespace
@@ -40,14 +63,22 @@ FlowSetup prepare_flow(const Vertices& V, const Faces& F, const Topology& topolo
   setup.mean_edge_length = mean_edge_length(V, topology);
   setup.scale = setup.mean_edge_length > 0 ? setup.mean_edge_length : 1.0;
   setup.input = (V.rowwise() - setup.centroid) / setup.scale;
+  if (options.min_quality > 0 && options.weights.sliver > 0) {
+    const Eigen::VectorXd quality = triangle_quality(setup.input, F);
+    for (Index f = 0; f < static_cast<Index>(F.rows()); ++f)
+      if (quality[f] < options.min_quality) setup.sliver_faces.push_back(f);
+  }
   return setup;
 }
 
-FlowFrame flow_frame(const Vertices& X, const Faces& F, const Topology& topology, const FlowOptions& options) {
+FlowFrame flow_frame(const Vertices& X, const Faces& F, const Topology& topology, const FlowOptions& options,
+                     const std::vector<Index>& sliver_faces) {
   FlowFrame frame;
   frame.P = X;
   frame.curvature = principal_curvatures(X, F, topology, options.curvature);
   frame.d = robust_radius(frame.curvature, options.d_percentile);
+  if (!sliver_faces.empty())
+    frame.sliver_stiffness = sliver_stiffness(X, F, sliver_faces, static_cast<Index>(X.rows()));
   return frame;
 }
 

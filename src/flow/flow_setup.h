@@ -25,13 +25,18 @@ struct FlowSetup {
   double scale = 1;
   double mean_edge_length = 0;
   Vertices input;
+  /// The faces whose input quality is below options.min_quality (flow_energy.h, F_sliver);
+  /// empty when min_quality or weights.sliver is 0.
+  std::vector<Index> sliver_faces;
 };
 
 /// The preparation of vertex_flow for valid options and a valid mesh.
 FlowSetup prepare_flow(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options);
 
 /// The frame of one solve at positions X (normalised units): X, its curvature
-/// (options.curvature) and the radius d of Eq. 6 at options.d_percentile.
-FlowFrame flow_frame(const Vertices& X, const Faces& F, const Topology& topology, const FlowOptions& options);
+/// (options.curvature), the radius d of Eq. 6 at options.d_percentile and F_sliver's
+/// stiffness at X for `sliver_faces` (none if empty).
+FlowFrame flow_frame(const Vertices& X, const Faces& F, const Topology& topology, const FlowOptions& options,
+                     const std::vector<Index>& sliver_faces = {});
 
 }  // namespace vertexflow

@@ -37,7 +37,8 @@ FlowTerms make_flow_terms(const Topology& topology, const std::vector<char>& fix
   const Curvature& c = frame.curvature;
   const double nv = std::max<double>(t.n, 1);
   const double w_em = topology.num_edges() > 0 ? 1.0 / topology.num_edges() : 0.0;
-  const double w_sd = weights.lambda / nv, w_pull = weights.epsilon * weights.lambda / nv;
+  const double w_sd = weights.lambda / nv, w_pull = weights.epsilon * weights.lambda / nv,
+               w_sliver = weights.sliver / nv;
   parallel_for_index(t.n, [&](Index k) {
     const auto v = static_cast<std::size_t>(k);
     const Index i = t.original[v];
@@ -48,6 +49,7 @@ FlowTerms make_flow_terms(const Topology& topology, const std::vector<char>& fix
         w_sd * (distance_coefficient(frame.d, c.k1[i]) * t1 * t1.transpose() +
                 distance_coefficient(frame.d, c.k2[i]) * t2 * t2.transpose() + normal * normal.transpose());
     distance.diagonal().array() += w_pull;
+    if (!frame.sliver_stiffness.empty()) distance += w_sliver * frame.sliver_stiffness[static_cast<std::size_t>(i)];
     t.D[v] = Sym3(distance);
     const Index degree = topology.valence(i);
     t.inv_degree[v] = degree > 0 ? 1.0 / degree : 0.0;

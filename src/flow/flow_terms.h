@@ -12,7 +12,7 @@
 //   L   the uniform Laplacian of Eq. 8, S = diag(mu mu_i / |V|), mu_i = exp(-(|k1| + |k2|))
 //       (Eq. 9-10), R the fairness targets r_i (FairnessTarget)
 //   D_i = lambda/|V| (c_i1 T_i1 T_i1^T + c_i2 T_i2 T_i2^T + N_i N_i^T) + epsilon lambda/|V| I:
-//       F_sd (Eq. 6-7) and the pull.
+//       + sliver/|V| S_i: F_sd (Eq. 6-7), the pull and F_sliver (S_i = frame.sliver_stiffness).
 // Rows and columns of fixed vertices are removed (their d is 0). So H x costs two passes over
 // the one-rings (no matrix), and any block of H is a short sum over the vertices whose
 // one-rings contain both of its vertices.

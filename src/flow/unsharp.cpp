@@ -10,6 +10,41 @@
 #include <string>
 
 namespace vertexflow {
+namespace {
+
+// As the flow does (flow.cpp): the split's copies of held vertices are pinned, so every input
+// vertex has one position to return.
+UnsharpResult unsharp_on_manifold_split(const Vertices& V, const Faces& F, const Topology& topology,
+                                        const UnsharpOptions& options) {
+  const ManifoldSplit split = split_non_manifold(V, F, topology);
+  UnsharpOptions on_split = options;
+  on_split.refuse_non_manifold = true;
+  on_split.pinned.clear();
+  const auto n = static_cast<Index>(V.rows());
+  for (const Index p : options.pinned)
+    if (p < 0 || p >= n)
+      throw std::invalid_argument("unsharp mask: pinned vertex " + std::to_string(p) + " is out of range");
+  std::vector<char> hold(static_cast<std::size_t>(n), 0);
+  for (const Index p : options.pinned) hold[static_cast<std::size_t>(p)] = 1;
+  for (Index v = 0; v < n; ++v) {
+    if (!hold[static_cast<std::size_t>(v)] && !split.held[static_cast<std::size_t>(v)]) continue;
+    for (Index s = split.first_copy[static_cast<std::size_t>(v)]; s < split.first_copy[static_cast<std::size_t>(v) + 1];
+         ++s)
+      on_split.pinned.push_back(s);
+  }
+  const UnsharpResult on_copies = unsharp_mask(split.V, split.F, on_split);
+  UnsharpResult result;
+  result.V = V;
+  for (Index v = 0; v < n; ++v)
+    if (!split.held[static_cast<std::size_t>(v)])
+      result.V.row(v) = on_copies.V.row(split.first_copy[static_cast<std::size_t>(v)]);
+  // Counted per input vertex: a held vertex's extra copies were fixed too.
+  result.fixed_vertices = on_copies.fixed_vertices - (static_cast<Index>(split.V.rows()) - n);
+  result.non_manifold = split.counts();
+  return result;
+}
+
+}  // namespace
 
 UnsharpResult unsharp_mask(const Vertices& V, const Faces& F, const UnsharpOptions& options) {
   const Index n = static_cast<Index>(V.rows());
@@ -18,7 +53,10 @@ UnsharpResult unsharp_mask(const Vertices& V, const Faces& F, const UnsharpOptio
     throw std::invalid_argument("unsharp mask: smoothing iterations must not be negative");
   if (!std::isfinite(options.weight)) throw std::invalid_argument("unsharp mask: the weight must be finite");
   const Topology topology = build_topology(F, n);
-  if (!topology.is_manifold()) throw std::invalid_argument("unsharp mask: " + describe_non_manifold(topology));
+  if (!topology.is_manifold()) {
+    if (options.refuse_non_manifold) throw std::invalid_argument("unsharp mask: " + describe_non_manifold(topology));
+    return unsharp_on_manifold_split(V, F, topology, options);
+  }
 
   std::vector<char> fixed(static_cast<std::size_t>(n), 0);
   for (Index i = 0; i < n; ++i)

@@ -45,6 +45,7 @@ void to_json(nlohmann::json& j, const EnergyWeights& weights) {
   j = {{"lambda", weights.lambda},
        {"mu", weights.mu},
        {"epsilon", weights.epsilon},
+       {"sliver", weights.sliver},
        {"fairness_target", weights.fairness_target}};
 }
 
@@ -98,11 +99,16 @@ void to_json(nlohmann::json& j, const UnsharpOptions& options) {
   j = {{"weight", options.weight},
        {"smoothing_iterations", options.smoothing_iterations},
        {"fix_boundary", options.fix_boundary},
-       {"pinned", options.pinned.size()}};
+       {"pinned", options.pinned.size()},
+       {"refuse_non_manifold", options.refuse_non_manifold}};
 }
 
 void to_json(nlohmann::json& j, const UnsharpResult& result) {
-  j = {{"fixed_vertices", result.fixed_vertices}};
+  j = {{"fixed_vertices", result.fixed_vertices},
+       {"non_manifold",
+        {{"held_vertices", result.non_manifold.held_vertices},
+         {"reoriented_faces", result.non_manifold.reversed_faces},
+         {"cut_edges", result.non_manifold.cut_edges}}}};
 }
 
 void to_json(nlohmann::json& j, const FitOptions& options) {

@@ -185,8 +185,19 @@ TEST(CliEnhanceUnsharp, OptionsOfTheOtherMethodAreRefused) {
                                 " --method unsharp --lambda 2"),
                         "--lambda applies to --method flow only");
   expect_one_line_error(run_cli("--quiet enhance " + shell_quote(write_bowtie(dir).string()) + " " +
-                                shell_quote(out.string()) + " --method unsharp"),
+                                shell_quote(out.string()) + " --method unsharp --strict"),
                         "bowtie.obj: unsharp mask: the mesh is not manifold");
+  EXPECT_FALSE(std::filesystem::exists(out));
+  // Without --strict the bowtie is smoothed as its manifold split, with one warning line.
+  const auto report = dir.file("bowtie.json");
+  const auto split = run_cli("enhance " + shell_quote(write_bowtie(dir).string()) + " " + shell_quote(out.string()) +
+                             " --method unsharp --report " + shell_quote(report.string()));
+  ASSERT_EQ(split.exit_code, 0) << split.err;
+  EXPECT_NE(split.err.find("bowtie.obj: the mesh is not manifold or not consistently oriented: 1 vertices held"),
+            std::string::npos)
+      << split.err;
+  EXPECT_EQ(nlohmann::json::parse(test::read_text(report))["non_manifold"]["held_vertices"], 1);
+  std::filesystem::remove(out);
   EXPECT_NE(run_cli("enhance " + quoted_data_path("spot.obj") + " " + shell_quote(out.string()) + " --method laplace")
                 .exit_code,
             0);

@@ -5,6 +5,7 @@
 #include "test_support.h"
 
 #include "flow_operator.h"
+#include "flow_setup.h"
 #include "flow_terms.h"
 #include "vertexflow/flow_energy.h"
 #include "vertexflow/io.h"
@@ -160,6 +161,52 @@ TEST_P(EnergyEncoding, FairnessTargetsMatchTheirFormulas) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Meshes, EnergyEncoding, ::testing::Values(0, 1, 2));
+
+// F_sliver's encoding: with random positive semi-definite blocks S_i in the frame, the running
+// operator's change equals sliver * F_sliver's formula.
+TEST_P(EnergyEncoding, SliverTermMatchesItsFormula) {
+  EnergyCase s = make_case();
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> entry(-1.0, 1.0);
+  s.frame.sliver_stiffness.resize(static_cast<std::size_t>(s.mesh.num_vertices()));
+  for (Eigen::Matrix3d& block : s.frame.sliver_stiffness) {
+    Eigen::Matrix3d a;
+    for (Eigen::Index k = 0; k < 9; ++k) a.data()[k] = entry(rng);
+    block = a * a.transpose();
+  }
+  const double f_sliver = sliver_energy(s.X, s.frame);
+  ASSERT_GT(f_sliver, 0);
+  EXPECT_EQ(sliver_energy(s.frame.P, s.frame), 0);
+  EnergyWeights only_tan{0.0, 0.0, 0.0};
+  only_tan.sliver = 0;
+  EnergyWeights with_sliver = only_tan;
+  with_sliver.sliver = 3.0;
+  const double tan = energy_change(s, only_tan, s.X);
+  EXPECT_NEAR(energy_change(s, with_sliver, s.X) - tan, 3.0 * f_sliver, 1e-10 * (std::abs(tan) + f_sliver));
+}
+
+// F_sliver's blocks (flow_setup.h): a corner that moves towards its opposite edge by its
+// altitude costs 1, along that edge 0; the corners of faces that are not slivers cost nothing.
+TEST(SliverStiffness, CornerMovingByItsAltitudeCostsOne) {
+  Mesh mesh;
+  mesh.V.resize(4, 3);
+  mesh.V << 0, 0, 0, 1, 0, 0, 0.5, 0.05, 0, 0.5, -0.8, 0;
+  mesh.F.resize(2, 3);
+  mesh.F << 0, 1, 2, 1, 0, 3;
+  const Topology topology = build_topology(mesh.F, mesh.num_vertices());
+  const FlowFrame frame = flow_frame(mesh.V, mesh.F, topology, FlowOptions{}, {0});
+  ASSERT_EQ(frame.sliver_stiffness.size(), 4u);
+  const Eigen::Matrix3d& apex = frame.sliver_stiffness[2];
+  const Eigen::Vector3d towards_edge(0, -0.05, 0), along_edge(0.3, 0, 0), off_plane(0, 0, 0.3);
+  EXPECT_NEAR(towards_edge.dot(apex * towards_edge), 1.0, 1e-12);
+  EXPECT_NEAR(along_edge.dot(apex * along_edge), 0.0, 1e-12);
+  EXPECT_NEAR(off_plane.dot(apex * off_plane), 0.0, 1e-12);
+  EXPECT_TRUE(frame.sliver_stiffness[3].isZero());  // only in face 1, which is not listed
+  // Corner 0's altitude is the distance to the line through 1 and 2.
+  const Eigen::Vector3d e = (mesh.V.row(2) - mesh.V.row(1)).transpose().normalized();
+  const Eigen::Vector3d to_line = -(Eigen::Vector3d(-1, 0, 0) - e * e.dot(Eigen::Vector3d(-1, 0, 0)));
+  EXPECT_NEAR(to_line.dot(frame.sliver_stiffness[0] * to_line), 1.0, 1e-9);
+}
 
 TEST(EdgeMetric, HandComputedEdge) {
   // One triangle; every vertex has k1 = 2 along x and k2 = -0.5 along y (normal +z).

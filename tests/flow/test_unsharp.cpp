@@ -165,10 +165,40 @@ TEST(Unsharp, InvariantUnderRigidMotionAndUniformScale) {
   EXPECT_GT((moved - transform(head.V)).rowwise().norm().maxCoeff(), 1e-4 * size);
 }
 
+// Non-manifold input is smoothed as its manifold split (unsharp.h): the vertices of a manifold
+// component keep exactly the result they have alone, the non-manifold ones are held bit for bit.
+TEST(Unsharp, NonManifoldMeshIsSmoothedAsItsManifoldSplit) {
+  const Mesh spot = read_mesh(test::data_path("spot.obj"));
+  const Mesh bowtie = test::bowtie();
+  Mesh both;
+  both.V.resize(spot.num_vertices() + bowtie.num_vertices(), 3);
+  both.V << spot.V, (bowtie.V.rowwise() + Eigen::RowVector3d(5, 0, 0));
+  both.F.resize(spot.num_faces() + bowtie.num_faces(), 3);
+  both.F << spot.F, (bowtie.F.array() + spot.num_vertices());
+  const Topology topology = build_topology(both.F, both.num_vertices());
+  ASSERT_FALSE(topology.is_manifold());
+  const UnsharpResult result = unsharp_mask(both.V, both.F);
+  EXPECT_EQ(result.V.topRows(spot.num_vertices()), unsharp_mask(spot.V, spot.F).V);
+  ASSERT_FALSE(topology.non_manifold_vertices.empty());
+  for (const Index v : topology.non_manifold_vertices) EXPECT_EQ(result.V.row(v), both.V.row(v)) << v;
+  EXPECT_EQ(result.non_manifold.held_vertices, static_cast<Index>(topology.non_manifold_vertices.size()));
+  EXPECT_GT(result.non_manifold.cut_edges + result.non_manifold.held_vertices, 0);
+  // On a vertex-clustered bunny (113 non-manifold edges) the free vertices move.
+  const Mesh bunny = read_mesh(test::data_path("bunny.off"));
+  const Mesh clustered = test::vertex_clustered(bunny, 0.03 * bounding_box(bunny.V).diagonal());
+  const Topology clustered_topology = build_topology(clustered.F, clustered.num_vertices());
+  ASSERT_FALSE(clustered_topology.is_manifold());
+  const UnsharpResult sharpened = unsharp_mask(clustered.V, clustered.F);
+  for (const Index v : clustered_topology.non_manifold_vertices) ASSERT_EQ(sharpened.V.row(v), clustered.V.row(v)) << v;
+  EXPECT_GT((sharpened.V - clustered.V).rowwise().norm().mean(), 1e-3 * bounding_box(bunny.V).diagonal());
+}
+
 TEST(Unsharp, BadInputIsRefused) {
   const Mesh bowtie = test::bowtie();
   try {
-    unsharp_mask(bowtie.V, bowtie.F);
+    UnsharpOptions strict;
+    strict.refuse_non_manifold = true;
+    unsharp_mask(bowtie.V, bowtie.F, strict);
     FAIL() << "non-manifold mesh accepted";
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("unsharp mask: the mesh is not manifold"), std::string::npos) << e.what();

@@ -40,13 +40,15 @@ TEST(ReportJson, EnumerationsAreNames) {
 
 TEST(ReportJson, EnergyWeightsEveryField) {
   EnergyWeights weights;
-  auto& [lambda, mu, epsilon, fairness_target] = weights;
+  auto& [lambda, mu, epsilon, fairness_target, sliver] = weights;
   lambda = 0.25;
   mu = 0.75;
   epsilon = 1e-4;
   fairness_target = FairnessTarget::Zero;
+  sliver = 0.5;
   const nlohmann::json j = weights;
-  EXPECT_EQ(j, nlohmann::json::parse(R"({"lambda": 0.25, "mu": 0.75, "epsilon": 1e-4, "fairness_target": "zero"})"));
+  EXPECT_EQ(j, nlohmann::json::parse(
+                   R"({"lambda": 0.25, "mu": 0.75, "epsilon": 1e-4, "fairness_target": "zero", "sliver": 0.5})"));
   expect_every_value_differs(j, EnergyWeights{});
 }
 
@@ -68,6 +70,7 @@ TEST(ReportJson, FlowOptionsEveryField) {
   weights.mu = 0.75;
   weights.epsilon = 1e-4;
   weights.fairness_target = FairnessTarget::Zero;
+  weights.sliver = 0.5;
   d_percentile = 95;
   iterations = 3;
   project_to_input = false;
@@ -85,7 +88,7 @@ TEST(ReportJson, FlowOptionsEveryField) {
   const nlohmann::json j = options;
   // The weights' keys stay at the top level, where the report has always had them.
   EXPECT_EQ(j, nlohmann::json::parse(R"({
-    "lambda": 0.25, "mu": 0.75, "epsilon": 1e-4, "fairness_target": "zero",
+    "lambda": 0.25, "mu": 0.75, "epsilon": 1e-4, "fairness_target": "zero", "sliver": 0.5,
     "d_percentile": 95.0, "iterations": 3, "project_to_input": false, "feature_angle": 30.0,
     "fix_boundary": false, "pinned": 3, "refuse_non_manifold": true, "max_halvings": 12, "min_quality": 0.2,
     "sliver_floor": 0.25,
@@ -147,21 +150,24 @@ TEST(ReportJson, FlowReportEveryFieldInItsSection) {
 
 TEST(ReportJson, UnsharpOptionsAndResultEveryField) {
   UnsharpOptions options;
-  auto& [weight, smoothing_iterations, fix_boundary, pinned] = options;
+  auto& [weight, smoothing_iterations, fix_boundary, pinned, refuse_non_manifold] = options;
   weight = 0.5;
   smoothing_iterations = 7;
   fix_boundary = false;
   pinned = {1, 2};
+  refuse_non_manifold = true;
   const nlohmann::json j = options;
-  EXPECT_EQ(j,
-            nlohmann::json::parse(R"({"weight": 0.5, "smoothing_iterations": 7, "fix_boundary": false, "pinned": 2})"));
+  EXPECT_EQ(j, nlohmann::json::parse(R"({"weight": 0.5, "smoothing_iterations": 7, "fix_boundary": false,
+                                         "pinned": 2, "refuse_non_manifold": true})"));
   expect_every_value_differs(j, UnsharpOptions{});
 
   UnsharpResult result;
-  auto& [V, fixed_vertices] = result;
+  auto& [V, fixed_vertices, non_manifold] = result;
   V = Vertices::Ones(3, 3);  // positions are for the mesh file, not the report
   fixed_vertices = 9;
-  EXPECT_EQ(nlohmann::json(result), nlohmann::json::parse(R"({"fixed_vertices": 9})"));
+  non_manifold = {4, 5, 6};
+  EXPECT_EQ(nlohmann::json(result), nlohmann::json::parse(R"({"fixed_vertices": 9, "non_manifold":
+                                    {"held_vertices": 4, "reoriented_faces": 5, "cut_edges": 6}})"));
 }
 
 }  // namespace
