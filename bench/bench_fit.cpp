@@ -1,7 +1,7 @@
 // fit_to_reference (fit.h), reference mode of issue 16: a 10k-vertex remesh of bunny.off fitted
 // to bunny.off subdivided 1-to-16 (557k vertices, 1.1M faces), the tree over the reference and
 // the sampling included; and the same remesh against bunny.off itself (35k vertices). Counters:
-// rounds and the phases of FitReport in milliseconds per run.
+// rounds and the phases of FitReport in milliseconds per run. Results: docs/benchmarks.md.
 //
 //   build/bin/bench_fit --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include "bench_support.h"

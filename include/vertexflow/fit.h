@@ -77,6 +77,8 @@ struct FitReport {
   Index flipped_before_guard = 0;  ///< summed over rounds
   Index low_quality_before_guard = 0;
   Index limited_vertices = 0;  ///< vertices the guard left short in any round
+  /// Wall-clock seconds: seconds_tree is the reference's tree, built alongside its samples and
+  /// the ordering and analysis of the linear system; the others sum over the rounds.
   double seconds_tree = 0, seconds_queries = 0, seconds_solve = 0, seconds_guard = 0;
 };
 

@@ -102,6 +102,37 @@ TEST(DistanceQuery, MatchesBruteForceOnSmallMeshes) {
   }
 }
 
+// From 200k faces the query splits the faces into two trees (distance.cpp): the answers are
+// still exact, name the input's faces, and do not depend on the thread count.
+TEST(DistanceQuery, MatchesBruteForceOnALargeMeshOfTwoTrees) {
+  const Mesh mesh = test::torus(1.0, 0.3, 500, 201);  // 201,000 faces
+  ASSERT_GE(mesh.num_faces(), 200000);
+  const DistanceQuery query(mesh.V, mesh.F);
+  const Vertices P = query_points(mesh, 90, 3);
+  const std::vector<ClosestPoint> closest = query.closest_points(P);
+  const double scale = bounding_box(mesh.V).diagonal();
+  double largest = 0;
+  for (Index i = 0; i < P.rows(); ++i) {
+    const Eigen::Vector3d p = P.row(i).transpose();
+    const ClosestPoint& c = closest[static_cast<std::size_t>(i)];
+    const double expected = brute_force_distance(p, mesh);
+    largest = std::max(largest, expected);
+    ASSERT_NEAR(std::sqrt(c.squared_distance), expected, 1e-12 * scale) << "point " << i;
+    EXPECT_NEAR(point_triangle_distance(p, mesh, c.face), expected, 1e-12 * scale) << "point " << i;
+    EXPECT_NEAR(query.closest_point(p).squared_distance, c.squared_distance, 1e-24 * scale * scale);
+  }
+  EXPECT_NEAR(std::sqrt(query.max_squared_distance(P)), largest, 1e-12 * scale);
+  std::vector<ClosestPoint> one_thread;
+  {
+    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
+    one_thread = DistanceQuery(mesh.V, mesh.F).closest_points(P);
+  }
+  for (std::size_t i = 0; i < closest.size(); ++i) {
+    EXPECT_EQ(one_thread[i].face, closest[i].face);
+    EXPECT_EQ(one_thread[i].point, closest[i].point);
+  }
+}
+
 TEST(DistanceQuery, DegenerateTriangleIsItsLongestEdge) {
   Mesh line;
   line.V.resize(3, 3);
