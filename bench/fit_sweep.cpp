@@ -9,6 +9,7 @@
 #include "vertexflow/quality.h"
 #include "vertexflow/timing.h"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -39,6 +40,7 @@ int main(int argc, char** argv) {
   }
   FitOptions o;
   bool flow_first = false;
+  int smooth = 0;  // > 0: fit to the PN estimate of COARSE with this many segments, not to DENSE
   for (int a = 3; a < argc; ++a) {
     const std::string s = argv[a];
     const auto eq = s.find('=');
@@ -58,6 +60,8 @@ int main(int argc, char** argv) {
       o.tolerance = v;
     else if (k == "minq")
       o.min_quality = v;
+    else if (k == "smooth")
+      smooth = static_cast<int>(v);
     else if (k == "flow")
       flow_first = v != 0;
     else {
@@ -70,7 +74,10 @@ int main(int argc, char** argv) {
   const auto start = std::chrono::steady_clock::now();
   Vertices start_V = coarse.V;
   if (flow_first) start_V = vertex_flow(coarse.V, coarse.F).V;
-  const FitResult r = fit_to_reference(start_V, coarse.F, dense.V, dense.F, o);
+  SmoothSurfaceOptions pn;
+  pn.segments = std::max(smooth, 1);
+  const Mesh target = smooth > 0 ? smooth_surface_estimate(coarse.V, coarse.F, pn) : dense;
+  const FitResult r = fit_to_reference(start_V, coarse.F, target.V, target.F, o);
   const double seconds = seconds_since(start);
   const TwoSided in = two_sided(coarse.V, coarse.F, dense), out = two_sided(r.V, coarse.F, dense);
   std::printf(

@@ -63,6 +63,9 @@ void to_json(nlohmann::json& j, const UnsharpResult& result);
 /// Every field of FitOptions (pinned as its count).
 void to_json(nlohmann::json& j, const FitOptions& options);
 
+/// Every field of SmoothSurfaceOptions.
+void to_json(nlohmann::json& j, const SmoothSurfaceOptions& options);
+
 /// Three sections, as the enhance report has them: "fit" (rms_distance, one entry for the start
 /// and one per round, in the meshes' units; rounds; converged; reference_samples), "guard" (the
 /// guard's counts, as the flow's) and "seconds" (per phase).

@@ -139,7 +139,12 @@ void to_json(nlohmann::json& j, const FitReport& report) {
         {{"tree", report.seconds_tree},
          {"queries", report.seconds_queries},
          {"solve", report.seconds_solve},
-         {"guard", report.seconds_guard}}}};
+         {"guard", report.seconds_guard},
+         {"surface", report.seconds_surface}}}};
+}
+
+void to_json(nlohmann::json& j, const SmoothSurfaceOptions& options) {
+  j = {{"segments", options.segments}, {"feature_angle", options.feature_angle}};
 }
 
 }  // namespace vertexflow

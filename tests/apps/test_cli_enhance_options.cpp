@@ -2,6 +2,7 @@
 // vertex_flow called with the same option, and differ from the defaults') and has its
 // documented effect (flow.h, command_enhance.cpp). These options produce the Fig. 4 and 5
 // numbers of docs/results.md.
+#include "shapes.h"
 #include "test_support.h"
 
 #include "vertexflow/distance.h"
@@ -164,6 +165,49 @@ TEST(CliEnhanceOptions, ReferenceFitsToTheDenseMesh) {
                                      test::quoted(dir.file("x.ply")) + " --reference /nonexistent/dense.off");
   EXPECT_EQ(missing.exit_code, 1);
   EXPECT_NE(missing.err.find("/nonexistent/dense.off"), std::string::npos) << missing.err;
+}
+
+// Smooth mode: the CLI's output is the library's (fit_to_smooth_surface with the CLI's feature
+// angle and rounds), the report names the mode and the estimate's options, options of the
+// other modes are refused, and a mesh that looks decimated gets a one-line warning.
+TEST(CliEnhanceOptions, SmoothSurfaceFitsTheEstimate) {
+  const Mesh mesh = read_mesh(test::data_path("sphere_low.off"));
+  test::ScratchDir dir("cli-enhance-smooth");
+  const auto out = dir.file("out.ply"), report = dir.file("report.json");
+  const auto r = test::run_cli("--quiet enhance " + test::quoted_data_path("sphere_low.off") + " " + test::quoted(out) +
+                               " --surface smooth --feature-angle 60 --max-rounds 3 --report " + test::quoted(report));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  SmoothFitOptions options;
+  options.surface.feature_angle = 60;
+  options.fit.max_rounds = 3;
+  const FitResult expected = fit_to_smooth_surface(mesh.V, mesh.F, options);
+  EXPECT_EQ(read_mesh(out).V, expected.V);
+  EXPECT_NE(expected.V, mesh.V);
+  const nlohmann::json j = nlohmann::json::parse(test::read_text(report));
+  EXPECT_EQ(j["method"], "smooth");
+  EXPECT_EQ(j["fit"]["rounds"], expected.report.rounds);
+  EXPECT_EQ(j["options"]["surface"]["feature_angle"], 60.0);
+  EXPECT_EQ(j["options"]["samples_per_vertex"], 5.0);
+  EXPECT_TRUE(j["seconds"].contains("surface"));
+  for (const std::string& bad :
+       std::vector<std::string>{"--lambda 2", "--no-projection", "--strict", "--method unsharp",
+                                "--reference " + test::quoted_data_path("sphere.off")}) {
+    const auto refused = test::run_cli("enhance " + test::quoted_data_path("sphere_low.off") + " " +
+                                       test::quoted(dir.file("x.ply")) + " --surface smooth " + bad);
+    EXPECT_EQ(refused.exit_code, 1) << bad;
+    EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("x.ply")));
+  }
+  // A mesh with most faces below quality 0.3, as decimated meshes have.
+  const auto plate = dir.file("plate.off");
+  write_mesh(plate, test::sliver_plate(2, 8, 0.15, 0.4, 1));
+  const auto warned = test::run_cli("enhance " + test::quoted(plate) + " " + test::quoted(out) + " --surface smooth");
+  ASSERT_EQ(warned.exit_code, 0) << warned.err;
+  EXPECT_NE(warned.err.find("plate.off: "), std::string::npos) << warned.err;
+  EXPECT_NE(warned.err.find("as on decimated meshes"), std::string::npos) << warned.err;
+  const auto quiet = test::run_cli("enhance " + test::quoted_data_path("sphere_low.off") + " " + test::quoted(out) +
+                                   " --surface smooth");
+  EXPECT_EQ(quiet.err.find("decimated"), std::string::npos) << quiet.err;
 }
 
 TEST(CliEnhanceOptions, NoProjectionLeavesTheSurface) {

@@ -1,0 +1,142 @@
+// The smooth-surface estimate of fit.h: PN triangles (Vlachos, Peters, Boyd and Mitchell,
+// "Curved PN triangles", I3D 2001) over the input, with creases kept straight.
+#include "vertexflow/fit.h"
+
+#include "numerics/parallel.h"
+#include "vertexflow/timing.h"
+#include "vertexflow/topology.h"
+
+#include <chrono>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+
+namespace vertexflow {
+namespace {
+
+Eigen::Vector3d row3(const Vertices& M, Index i) {
+  return M.row(i).transpose();
+}
+
+// The interior angle of face f at its corner k.
+double corner_angle(const Vertices& V, const Faces& F, Index f, int k) {
+  const Eigen::Vector3d a = row3(V, F(f, (k + 1) % 3)) - row3(V, F(f, k)),
+                        b = row3(V, F(f, (k + 2) % 3)) - row3(V, F(f, k));
+  return std::atan2(a.cross(b).norm(), a.dot(b));
+}
+
+}  // namespace
+
+Mesh smooth_surface_estimate(const Vertices& V, const Faces& F, const SmoothSurfaceOptions& options) {
+  if (options.segments < 1) throw std::invalid_argument("smooth surface: segments must be at least 1");
+  if (!(options.feature_angle >= 0)) throw std::invalid_argument("smooth surface: feature_angle must be >= 0");
+  const Index n = V.rows(), m = F.rows();
+  const Topology topology = build_topology(F, n);
+  const double cos_crease = std::cos(options.feature_angle * std::numbers::pi / 180.0);
+  Vertices face_normals(m, 3);
+  for (Index f = 0; f < m; ++f) {
+    const Eigen::Vector3d normal = face_normal(V, F, f);  // mesh.h: length twice the area
+    face_normals.row(f) =
+        normal.norm() > 0 ? Eigen::RowVector3d(normal.normalized().transpose()) : Eigen::RowVector3d::Zero();
+  }
+
+  // Corner normals: per corner (f, k), the angle-weighted mean of the normals of the faces
+  // around its vertex that are within the feature angle of f's, so that a crease's two sides
+  // get their own normals. Edges: straight where the two faces meet at more than the feature
+  // angle, or at a boundary or non-manifold edge (one face, or more than two).
+  std::vector<Eigen::Vector3d> corner_normal(static_cast<std::size_t>(3 * m));
+  std::vector<char> straight(static_cast<std::size_t>(3 * m), 0);  // edge k -> k + 1 of face f
+  parallel_for_index(m, [&](Index f) {
+    const Eigen::Vector3d nf = face_normals.row(f).transpose();
+    for (int k = 0; k < 3; ++k) {
+      const Index v = F(f, k);
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      for (Index s = topology.face_offsets[static_cast<std::size_t>(v)];
+           s < topology.face_offsets[static_cast<std::size_t>(v) + 1]; ++s) {
+        const Index g = topology.vertex_faces[static_cast<std::size_t>(s)];
+        const Eigen::Vector3d ng = face_normals.row(g).transpose();
+        if (g != f && ng.dot(nf) < cos_crease) continue;
+        int corner = 0;
+        while (F(g, corner) != v) ++corner;
+        sum += corner_angle(V, F, g, corner) * ng;
+      }
+      corner_normal[static_cast<std::size_t>(3 * f + k)] = sum.norm() > 0 ? Eigen::Vector3d(sum.normalized()) : nf;
+      // The faces on the other side of edge (v, w).
+      const Index w = F(f, (k + 1) % 3);
+      int others = 0;
+      bool crease = false;
+      for (Index s = topology.face_offsets[static_cast<std::size_t>(v)];
+           s < topology.face_offsets[static_cast<std::size_t>(v) + 1]; ++s) {
+        const Index g = topology.vertex_faces[static_cast<std::size_t>(s)];
+        if (g == f || (F(g, 0) != w && F(g, 1) != w && F(g, 2) != w)) continue;
+        ++others;
+        if (face_normals.row(g).dot(nf) < cos_crease) crease = true;
+      }
+      straight[static_cast<std::size_t>(3 * f + k)] = others != 1 || crease;
+    }
+  });
+
+  const int s = options.segments;
+  const Index points_per_face = (s + 1) * (s + 2) / 2;
+  Mesh out;
+  out.V.resize(m * points_per_face, 3);
+  out.F.resize(m * s * s, 3);
+  parallel_for_index(m, [&](Index f) {
+    const Eigen::Vector3d P[3] = {row3(V, F(f, 0)), row3(V, F(f, 1)), row3(V, F(f, 2))};
+    // Control points: b[k] the corners, e[k][0], e[k][1] the two of edge k -> k + 1 (next to
+    // k and to k + 1), c the centre.
+    Eigen::Vector3d e[3][2];
+    for (int k = 0; k < 3; ++k) {
+      const int l = (k + 1) % 3;
+      const Eigen::Vector3d d = P[l] - P[k];
+      if (straight[static_cast<std::size_t>(3 * f + k)]) {
+        e[k][0] = P[k] + d / 3.0;
+        e[k][1] = P[l] - d / 3.0;
+      } else {
+        const Eigen::Vector3d& nk = corner_normal[static_cast<std::size_t>(3 * f + k)];
+        const Eigen::Vector3d& nl = corner_normal[static_cast<std::size_t>(3 * f + l)];
+        e[k][0] = (2.0 * P[k] + P[l] - d.dot(nk) * nk) / 3.0;
+        e[k][1] = (2.0 * P[l] + P[k] + d.dot(nl) * nl) / 3.0;
+      }
+    }
+    Eigen::Vector3d edge_mean = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) edge_mean += e[k][0] + e[k][1];
+    edge_mean /= 6.0;
+    const Eigen::Vector3d corner_mean = (P[0] + P[1] + P[2]) / 3.0;
+    const Eigen::Vector3d centre = edge_mean + (edge_mean - corner_mean) / 2.0;
+    // The cubic Bezier triangle at barycentric (u, v, w) for corners 0, 1, 2.
+    auto evaluate = [&](double u, double v, double w) -> Eigen::Vector3d {
+      return u * u * u * P[0] + v * v * v * P[1] + w * w * w * P[2] +
+             3.0 * (u * u * v * e[0][0] + u * v * v * e[0][1] + v * v * w * e[1][0] + v * w * w * e[1][1] +
+                    w * w * u * e[2][0] + w * u * u * e[2][1]) +
+             6.0 * u * v * w * centre;
+    };
+    const Index base = f * points_per_face;
+    auto index = [&](int i, int j) {  // row i (0..s), column j (0..s - i)
+      return base + i * (s + 1) - i * (i - 1) / 2 + j;
+    };
+    for (int i = 0; i <= s; ++i)
+      for (int j = 0; j <= s - i; ++j) {
+        const double v = static_cast<double>(i) / s, w = static_cast<double>(j) / s;
+        out.V.row(index(i, j)) = evaluate(1.0 - v - w, v, w).transpose();
+      }
+    Index t = f * s * s;
+    for (int i = 0; i < s; ++i)
+      for (int j = 0; j < s - i; ++j) {
+        out.F.row(t++) << index(i, j), index(i + 1, j), index(i, j + 1);
+        if (j + 1 < s - i) out.F.row(t++) << index(i + 1, j), index(i + 1, j + 1), index(i, j + 1);
+      }
+  });
+  return out;
+}
+
+FitResult fit_to_smooth_surface(const Vertices& V, const Faces& F, const SmoothFitOptions& options) {
+  const auto start = Clock::now();
+  const Mesh estimate = smooth_surface_estimate(V, F, options.surface);
+  const double seconds = seconds_since(start);
+  FitResult result = fit_to_reference(V, F, estimate.V, estimate.F, options.fit);
+  result.report.seconds_surface = seconds;
+  return result;
+}
+
+}  // namespace vertexflow
