@@ -46,6 +46,8 @@ int main(int argc, char** argv) {
       o.feature_angle = v;
     else if (k == "minq")
       o.min_quality = v;
+    else if (k == "csmooth")
+      o.curvature.smoothing_rounds = static_cast<int>(v);
     else if (k == "fair")
       o.weights.fairness_target = v != 0 ? FairnessTarget::InputNormal : FairnessTarget::Zero;
     else {
