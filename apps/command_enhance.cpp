@@ -42,6 +42,7 @@ struct EnhanceOptions {
   FitOptions fit;
   std::string surface = "input";
   SmoothFitOptions smooth;
+  bool assume_on_surface = false;
   std::string method = "flow";
   UnsharpOptions unsharp;
   bool keep_boundary_free = false;
@@ -202,36 +203,32 @@ MethodRun run_reference(const Mesh& mesh, const Mesh& reference, const FitOption
 
 // Smooth mode (fit.h): the vertices fitted to the PN-triangle estimate through them. Report: as
 // reference mode, and the estimate's options.
-MethodRun run_smooth(const Mesh& mesh, const SmoothFitOptions& options, const Progress& phase) {
+MethodRun run_smooth(const Mesh& mesh, const SmoothFitOptions& options, const Progress& phase, const Progress& warn) {
   FitResult result = fit_to_smooth_surface(mesh.V, mesh.F, options);
   const FitReport& r = result.report;
-  phase(
-      fmt::format("estimate {:.3f} s; fitted in {} rounds{}: RMS distance to it {:.6g} -> {:.6g}; {} vertices "
-                  "limited by the guard",
-                  r.seconds_surface, r.rounds, r.converged ? "" : " (max-rounds reached)", r.rms_distance.front(),
-                  r.rms_distance.back(), r.limited_vertices));
+  if (r.held_as_decimated)
+    warn(
+        fmt::format("{:.1f}% of the faces are below quality 0.3, as on decimated meshes, whose vertices lie off "
+                    "the surface: smooth mode, which assumes them on it, held every vertex (fit.h; "
+                    "--assume-on-surface fits anyway)",
+                    100 * r.poor_face_fraction));
+  else
+    phase(
+        fmt::format("patches {:.3f} s; fitted in {} round{}: RMS distance to them {:.6g} -> {:.6g}; {} vertices "
+                    "limited by the guard",
+                    r.seconds_surface, r.rounds, r.rounds == 1 ? "" : "s", r.rms_distance.front(),
+                    r.rms_distance.back(), r.limited_vertices));
   MethodRun run;
   run.report = r;
+  run.report["fit"]["poor_face_fraction"] = r.poor_face_fraction;
+  run.report["fit"]["held_as_decimated"] = r.held_as_decimated;
   run.report["options"] = options.fit;
+  for (const char* unused : {"samples_per_vertex", "mesh_to_reference_weight", "seed"})
+    run.report["options"].erase(unused);
   run.report["options"]["surface"] = options.surface;
+  run.report["options"]["max_poor_face_fraction"] = options.max_poor_face_fraction;
   run.V = std::move(result.V);
   return run;
-}
-
-// Smooth mode assumes the vertices lie on the surface; error-driven decimation (QEM) places them
-// off it and leaves many poorly shaped faces, which remeshes and scans rarely have (fit.h).
-// Measured: 5.6-10.7% of the faces below 0.3 on 3k-vertex simplify outputs, 0% on the 6k
-// remeshes; bunny.off, a scan, has 0.3%.
-void warn_if_decimated(const Mesh& mesh, const Progress& warn) {
-  const Eigen::VectorXd q = triangle_quality(mesh.V, mesh.F);
-  const double poor =
-      static_cast<double>((q.array() < 0.3).count()) / static_cast<double>(std::max<Index>(q.size(), 1));
-  if (poor > 0.03)
-    warn(
-        fmt::format("{:.1f}% of the faces are below quality 0.3, as on decimated meshes, whose vertices usually lie "
-                    "off the surface; --surface smooth assumes they lie on it and may then move the mesh away from "
-                    "the true surface (fit.h)",
-                    100 * poor));
 }
 
 // The unsharp-mask baseline (unsharp.h). Report: options, fixed_vertices, seconds.
@@ -334,9 +331,12 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str();
   command
       ->add_option("--max-rounds", o->fit.max_rounds,
-                   "Reference and smooth modes: rounds of foot points and solve at most")
-      ->check(CLI::Range(1, 100))
-      ->capture_default_str();
+                   "Reference and smooth modes: rounds of solve and guard at most (default 10 with --reference, "
+                   "1 with --surface smooth)")
+      ->check(CLI::Range(1, 100));
+  command->add_flag("--assume-on-surface", o->assume_on_surface,
+                    "Smooth mode: fit even inputs that look decimated (over 3% of the faces below quality 0.3), "
+                    "whose vertices usually lie off the surface (fit.h)");
   command->add_option("--html", o->html_file,
                       "Write an HTML report: both meshes in 3D, colour maps, histograms, metrics");
   command->add_flag("--force", o->force, "Allow OUT to be the input file");
@@ -359,6 +359,8 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
       if ((fit || smooth) && command->count(name) > 0 && !(smooth && std::string(name) == "--feature-angle"))
         throw std::runtime_error(std::string(name) + " does not apply to " +
                                  (fit ? "--reference" : "--surface smooth"));
+    if (!smooth && o->assume_on_surface)
+      throw std::runtime_error("--assume-on-surface applies to --surface smooth only");
     if (!fit && !smooth && command->count("--max-rounds") > 0)
       throw std::runtime_error("--max-rounds applies to --reference and --surface smooth only");
     if (!unsharp && (weight->count() > 0 || smoothing->count() > 0))
@@ -393,7 +395,8 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     o->smooth.fit.pinned = o->fit.pinned;
     o->smooth.fit.min_quality = o->fit.min_quality;
     o->smooth.fit.sliver_floor = o->fit.sliver_floor;
-    o->smooth.fit.max_rounds = o->fit.max_rounds;
+    if (command->count("--max-rounds") > 0) o->smooth.fit.max_rounds = o->fit.max_rounds;
+    if (o->assume_on_surface) o->smooth.max_poor_face_fraction = 1.0;
     Mesh reference;
     if (fit) {
       phase("reading " + o->reference_file);
@@ -419,8 +422,7 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
       if (fit) {
         run = run_reference(mesh, reference, o->fit, phase);
       } else if (smooth) {
-        warn_if_decimated(mesh, warn);
-        run = run_smooth(mesh, o->smooth, phase);
+        run = run_smooth(mesh, o->smooth, phase, warn);
       } else if (unsharp) {
         run = run_unsharp(mesh, o->unsharp, warn);
       } else {

@@ -69,7 +69,8 @@ struct FitOptions {
 
 struct FitReport {
   /// RMS of the data energy's two directions, sqrt((mean d^2 S->M + mean d^2 M->S) / 2), in
-  /// the meshes' units: at the start (index 0) and after each round.
+  /// the meshes' units: at the start (index 0) and after each round. Smooth mode: the
+  /// area-weighted RMS distance between the data points and their targets on the patches.
   std::vector<double> rms_distance;
   int rounds = 0;
   bool converged = false;  ///< stopped by the tolerance, not by max_rounds
@@ -80,8 +81,13 @@ struct FitReport {
   /// Wall-clock seconds: seconds_tree is the reference's tree, built alongside its samples and
   /// the ordering and analysis of the linear system; the others sum over the rounds.
   double seconds_tree = 0, seconds_queries = 0, seconds_solve = 0, seconds_guard = 0;
-  /// Smooth mode: building the estimate (0 in reference mode).
+  /// Smooth mode: building the patches (0 in reference mode); seconds_tree is then the
+  /// system's set-up.
   double seconds_surface = 0;
+  /// Smooth mode: the fraction of the input's faces below quality 0.3, and whether it was held
+  /// as decimated for exceeding SmoothFitOptions::max_poor_face_fraction (returned unchanged).
+  double poor_face_fraction = 0;
+  bool held_as_decimated = false;
 };
 
 struct FitResult {
@@ -108,29 +114,46 @@ struct SmoothSurfaceOptions {
 /// feature angle.
 Mesh smooth_surface_estimate(const Vertices& V, const Faces& F, const SmoothSurfaceOptions& options = {});
 
-/// Smooth mode: the fit of fit_to_reference with the smooth-surface estimate of the input as
-/// the reference, for when no dense mesh of the true surface exists. The estimate interpolates
-/// the input's vertices, so it assumes they lie on the true surface, as they do on scans,
-/// remeshes, subdivision and iso-surface output: there the faces move out to the surface
-/// they cut across (mean distance to the dense mesh -11% to -40% on 6k remeshes of bunny, amo,
-/// armadillo and horse). On meshes whose vertices were placed off the surface to fit it (QEM
-/// decimation with optimal placement, a previous run of a fitting mode) it moves them further
-/// out: the 3k-vertex `simplify` outputs of the same four models got 15-66% worse. Nothing in
-/// the geometry of a mesh tells the two apart (a sphere's inscribed and best-fitting meshes are
-/// the same mesh at two scales), so this function does not try; the CLI warns when the input
-/// looks decimated.
+/// Smooth mode: the vertices fitted to the PN-triangle patches of the input, for when no dense
+/// mesh of the true surface exists. Each face's data are the centroids of its segments^2
+/// subdivision triangles, each paired with the point of the face's patch at the same
+/// barycentric coordinates (the correspondence is fixed by the patch's parameters, so no
+/// closest-point search is needed), weighted by the face's area; the energy is fit.h's with
+/// these as the only data rows, and the guard of fit_to_reference follows each solve. One
+/// round by default: the correspondence does not change between rounds, and a second round
+/// gained 0.2 points of mean distance for 30% more time.
+///
+/// The patches interpolate the input's vertices, so the fit assumes they lie on the true
+/// surface, as they do on scans, remeshes, subdivision and iso-surface output: there the faces
+/// move out to the surface they cut across (mean distance to the dense mesh -12% to -42% on
+/// 6k remeshes of bunny, amo, armadillo and horse). On meshes whose vertices were placed off
+/// the surface to fit it (QEM decimation with optimal placement, a previous run of a fitting
+/// mode) the fit moves them further out: the 3k-vertex `simplify` outputs of the same four
+/// models got 26-100% worse. Geometry alone cannot tell the two apart (a sphere's inscribed and
+/// best-fitting meshes are the same mesh at two scales), but decimation leaves a mark that
+/// remeshing and scanning do not: thin triangles. Inputs with more than
+/// max_poor_face_fraction of their faces below quality 0.3 (triangle_quality, quality.h) are
+/// therefore held as decimated: returned unchanged, with FitReport::held_as_decimated set.
+/// Measured fractions: 5.6-10.7% on those four QEM outputs, 0% on the remeshes, at most 1.9%
+/// on the data meshes that are not decimated (fertility); camelhead (7.6%) and max-planck-5k
+/// (8.8%) are decimated scans. A previous run of smooth mode keeps the input's triangle
+/// shapes and is not detected (a second run moves the mesh further out; docs/results.md).
 struct SmoothFitOptions {
   SmoothSurfaceOptions surface;
-  /// The fit, with half the samples of reference mode: the estimate is smooth at the scale of
-  /// the faces (measured: 5 per vertex within 0.3 points of 10 on the meshes above).
+  /// Inputs with a larger fraction of faces below quality 0.3 are held as decimated (above);
+  /// 1 fits every input.
+  double max_poor_face_fraction = 0.03;
+  /// The fit's weights and guard; one round (above). samples_per_vertex, mesh_to_reference_weight
+  /// and seed are not used: the data are the patches' points.
   FitOptions fit = [] {
     FitOptions o;
-    o.samples_per_vertex = 5;
+    o.max_rounds = 1;
     return o;
   }();
 };
 
-/// smooth_surface_estimate of (V, F), then fit_to_reference of (V, F) to it. Throws as those.
+/// Smooth mode (above). Throws std::invalid_argument as fit_to_reference, as
+/// smooth_surface_estimate, and for max_poor_face_fraction outside [0, 1].
 FitResult fit_to_smooth_surface(const Vertices& V, const Faces& F, const SmoothFitOptions& options = {});
 
 /// Moves the vertices of (V, F) to minimise the two-sided distance to the reference surface

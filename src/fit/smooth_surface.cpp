@@ -2,7 +2,9 @@
 // "Curved PN triangles", I3D 2001) over the input, with creases kept straight.
 #include "vertexflow/fit.h"
 
+#include "fit_rounds.h"
 #include "numerics/parallel.h"
+#include "vertexflow/quality.h"
 #include "vertexflow/timing.h"
 #include "vertexflow/topology.h"
 
@@ -25,20 +27,32 @@ double corner_angle(const Vertices& V, const Faces& F, Index f, int k) {
   return std::atan2(a.cross(b).norm(), a.dot(b));
 }
 
-}  // namespace
+// The cubic Bezier triangle of one face: b the corners, e[k][0], e[k][1] the control points of
+// edge k -> k + 1 (next to k and to k + 1), c the centre.
+struct PnPatch {
+  Eigen::Vector3d b[3], e[3][2], c;
+  /// The point at barycentric (u, v, w) for corners 0, 1, 2.
+  Eigen::Vector3d at(double u, double v, double w) const {
+    return u * u * u * b[0] + v * v * v * b[1] + w * w * w * b[2] +
+           3.0 * (u * u * v * e[0][0] + u * v * v * e[0][1] + v * v * w * e[1][0] + v * w * w * e[1][1] +
+                  w * w * u * e[2][0] + w * u * u * e[2][1]) +
+           6.0 * u * v * w * c;
+  }
+};
 
-Mesh smooth_surface_estimate(const Vertices& V, const Faces& F, const SmoothSurfaceOptions& options) {
-  if (options.segments < 1) throw std::invalid_argument("smooth surface: segments must be at least 1");
+std::vector<PnPatch> pn_patches(const Vertices& V, const Faces& F, const Topology& topology,
+                                const SmoothSurfaceOptions& options) {
   if (!(options.feature_angle >= 0)) throw std::invalid_argument("smooth surface: feature_angle must be >= 0");
-  const Index n = V.rows(), m = F.rows();
-  const Topology topology = build_topology(F, n);
+  const Index m = F.rows();
   const double cos_crease = std::cos(options.feature_angle * std::numbers::pi / 180.0);
   Vertices face_normals(m, 3);
-  for (Index f = 0; f < m; ++f) {
+  Vertices corner_angles(m, 3);
+  parallel_for_index(m, [&](Index f) {
     const Eigen::Vector3d normal = face_normal(V, F, f);  // mesh.h: length twice the area
     face_normals.row(f) =
         normal.norm() > 0 ? Eigen::RowVector3d(normal.normalized().transpose()) : Eigen::RowVector3d::Zero();
-  }
+    for (int k = 0; k < 3; ++k) corner_angles(f, k) = corner_angle(V, F, f, k);
+  });
 
   // Corner normals: per corner (f, k), the angle-weighted mean of the normals of the faces
   // around its vertex that are within the feature angle of f's, so that a crease's two sides
@@ -58,7 +72,7 @@ Mesh smooth_surface_estimate(const Vertices& V, const Faces& F, const SmoothSurf
         if (g != f && ng.dot(nf) < cos_crease) continue;
         int corner = 0;
         while (F(g, corner) != v) ++corner;
-        sum += corner_angle(V, F, g, corner) * ng;
+        sum += corner_angles(g, corner) * ng;
       }
       corner_normal[static_cast<std::size_t>(3 * f + k)] = sum.norm() > 0 ? Eigen::Vector3d(sum.normalized()) : nf;
       // The faces on the other side of edge (v, w).
@@ -76,16 +90,12 @@ Mesh smooth_surface_estimate(const Vertices& V, const Faces& F, const SmoothSurf
     }
   });
 
-  const int s = options.segments;
-  const Index points_per_face = (s + 1) * (s + 2) / 2;
-  Mesh out;
-  out.V.resize(m * points_per_face, 3);
-  out.F.resize(m * s * s, 3);
+  std::vector<PnPatch> patches(static_cast<std::size_t>(m));
   parallel_for_index(m, [&](Index f) {
-    const Eigen::Vector3d P[3] = {row3(V, F(f, 0)), row3(V, F(f, 1)), row3(V, F(f, 2))};
-    // Control points: b[k] the corners, e[k][0], e[k][1] the two of edge k -> k + 1 (next to
-    // k and to k + 1), c the centre.
-    Eigen::Vector3d e[3][2];
+    PnPatch& patch = patches[static_cast<std::size_t>(f)];
+    const Eigen::Vector3d* P = patch.b;
+    for (int k = 0; k < 3; ++k) patch.b[k] = row3(V, F(f, k));
+    auto& e = patch.e;
     for (int k = 0; k < 3; ++k) {
       const int l = (k + 1) % 3;
       const Eigen::Vector3d d = P[l] - P[k];
@@ -103,14 +113,24 @@ Mesh smooth_surface_estimate(const Vertices& V, const Faces& F, const SmoothSurf
     for (int k = 0; k < 3; ++k) edge_mean += e[k][0] + e[k][1];
     edge_mean /= 6.0;
     const Eigen::Vector3d corner_mean = (P[0] + P[1] + P[2]) / 3.0;
-    const Eigen::Vector3d centre = edge_mean + (edge_mean - corner_mean) / 2.0;
-    // The cubic Bezier triangle at barycentric (u, v, w) for corners 0, 1, 2.
-    auto evaluate = [&](double u, double v, double w) -> Eigen::Vector3d {
-      return u * u * u * P[0] + v * v * v * P[1] + w * w * w * P[2] +
-             3.0 * (u * u * v * e[0][0] + u * v * v * e[0][1] + v * v * w * e[1][0] + v * w * w * e[1][1] +
-                    w * w * u * e[2][0] + w * u * u * e[2][1]) +
-             6.0 * u * v * w * centre;
-    };
+    patch.c = edge_mean + (edge_mean - corner_mean) / 2.0;
+  });
+  return patches;
+}
+
+}  // namespace
+
+Mesh smooth_surface_estimate(const Vertices& V, const Faces& F, const SmoothSurfaceOptions& options) {
+  if (options.segments < 1) throw std::invalid_argument("smooth surface: segments must be at least 1");
+  const std::vector<PnPatch> patches = pn_patches(V, F, build_topology(F, V.rows()), options);
+  const Index m = F.rows();
+  const int s = options.segments;
+  const Index points_per_face = (s + 1) * (s + 2) / 2;
+  Mesh out;
+  out.V.resize(m * points_per_face, 3);
+  out.F.resize(m * s * s, 3);
+  parallel_for_index(m, [&](Index f) {
+    const PnPatch& patch = patches[static_cast<std::size_t>(f)];
     const Index base = f * points_per_face;
     auto index = [&](int i, int j) {  // row i (0..s), column j (0..s - i)
       return base + i * (s + 1) - i * (i - 1) / 2 + j;
@@ -118,7 +138,7 @@ Mesh smooth_surface_estimate(const Vertices& V, const Faces& F, const SmoothSurf
     for (int i = 0; i <= s; ++i)
       for (int j = 0; j <= s - i; ++j) {
         const double v = static_cast<double>(i) / s, w = static_cast<double>(j) / s;
-        out.V.row(index(i, j)) = evaluate(1.0 - v - w, v, w).transpose();
+        out.V.row(index(i, j)) = patch.at(1.0 - v - w, v, w).transpose();
       }
     Index t = f * s * s;
     for (int i = 0; i < s; ++i)
@@ -131,11 +151,73 @@ Mesh smooth_surface_estimate(const Vertices& V, const Faces& F, const SmoothSurf
 }
 
 FitResult fit_to_smooth_surface(const Vertices& V, const Faces& F, const SmoothFitOptions& options) {
-  const auto start = Clock::now();
-  const Mesh estimate = smooth_surface_estimate(V, F, options.surface);
-  const double seconds = seconds_since(start);
-  FitResult result = fit_to_reference(V, F, estimate.V, estimate.F, options.fit);
-  result.report.seconds_surface = seconds;
+  validate_fit(V, F, options.fit, "smooth fit");
+  if (!(options.max_poor_face_fraction >= 0 && options.max_poor_face_fraction <= 1))
+    throw std::invalid_argument("smooth fit: max_poor_face_fraction must be in [0, 1]");
+  FitResult result;
+  FitReport& report = result.report;
+  report.poor_face_fraction = summarize_quality(triangle_quality(V, F)).fraction_below_0_3;
+  if (report.poor_face_fraction > options.max_poor_face_fraction) {
+    report.held_as_decimated = true;
+    result.V = V;
+    return result;
+  }
+  auto start = Clock::now();
+  Topology topology = build_topology(F, V.rows());
+  const std::vector<PnPatch> patches = pn_patches(V, F, topology, options.surface);
+  report.seconds_surface = seconds_since(start);
+  start = Clock::now();
+  FitRounds rounds(V, F, std::move(topology), options.fit);
+  report.seconds_tree = seconds_since(start);
+  // The data rows: the centroid of each of the segments^2 triangles of a face's subdivision,
+  // as the point of the face at those barycentric coordinates and its target on the face's
+  // patch, weighted by the face's area (the midpoint rule of the squared distance's integral
+  // over the face; corners are left out, where face and patch always agree).
+  const int s = options.surface.segments;
+  const Index points_per_face = s * s, m = F.rows();
+  std::vector<DataRow> rows(static_cast<std::size_t>(m * points_per_face));
+  parallel_for_index(m, [&](Index f) {
+    const PnPatch& patch = patches[static_cast<std::size_t>(f)];
+    const double area = 0.5 * face_normal(V, F, f).norm();
+    Index at = f * points_per_face;
+    auto add = [&](double i, double j) {
+      const double v = i / s, w = j / s, u = 1.0 - v - w;
+      rows[static_cast<std::size_t>(at++)] = {f, F.row(f).transpose(), {u, v, w}, patch.at(u, v, w), area};
+    };
+    for (int i = 0; i < s; ++i)
+      for (int j = 0; j < s - i; ++j) {
+        add(i + 1.0 / 3.0, j + 1.0 / 3.0);
+        if (j + 1 < s - i) add(i + 2.0 / 3.0, j + 2.0 / 3.0);
+      }
+  });
+  report.reference_samples = static_cast<Index>(rows.size());
+  auto mean_squared_distance = [&](const Vertices& X) {
+    double sum = 0, weights = 0;
+    for (const DataRow& row : rows) {
+      Eigen::Vector3d p = Eigen::Vector3d::Zero();
+      for (int k = 0; k < 3; ++k) p += row.weights[k] * X.row(row.corners[k]).transpose();
+      sum += row.weight * (p - row.target).squaredNorm();
+      weights += row.weight;
+    }
+    return weights > 0 ? sum / weights : 0.0;
+  };
+  Vertices X = V;
+  double previous = mean_squared_distance(X);
+  report.rms_distance.push_back(std::sqrt(previous));
+  for (int round = 0; round < options.fit.max_rounds; ++round) {
+    Vertices Y = rounds.step(X, rows, {}, report);
+    const double energy = mean_squared_distance(Y);
+    if (energy > previous) break;  // the guard held the round back so far it lost ground
+    X = std::move(Y);
+    report.rms_distance.push_back(std::sqrt(energy));
+    report.rounds = round + 1;
+    if (!(previous - energy > options.fit.tolerance * previous)) {
+      report.converged = true;
+      break;
+    }
+    previous = energy;
+  }
+  result.V = rounds.finish(std::move(X), report);
   return result;
 }
 

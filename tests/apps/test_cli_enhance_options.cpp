@@ -169,7 +169,8 @@ TEST(CliEnhanceOptions, ReferenceFitsToTheDenseMesh) {
 
 // Smooth mode: the CLI's output is the library's (fit_to_smooth_surface with the CLI's feature
 // angle and rounds), the report names the mode and the estimate's options, options of the
-// other modes are refused, and a mesh that looks decimated gets a one-line warning.
+// other modes are refused, and a mesh that looks decimated is held with a one-line warning
+// unless --assume-on-surface.
 TEST(CliEnhanceOptions, SmoothSurfaceFitsTheEstimate) {
   const Mesh mesh = read_mesh(test::data_path("sphere_low.off"));
   test::ScratchDir dir("cli-enhance-smooth");
@@ -187,7 +188,9 @@ TEST(CliEnhanceOptions, SmoothSurfaceFitsTheEstimate) {
   EXPECT_EQ(j["method"], "smooth");
   EXPECT_EQ(j["fit"]["rounds"], expected.report.rounds);
   EXPECT_EQ(j["options"]["surface"]["feature_angle"], 60.0);
-  EXPECT_EQ(j["options"]["samples_per_vertex"], 5.0);
+  EXPECT_EQ(j["options"]["max_poor_face_fraction"], 0.03);
+  EXPECT_FALSE(j["options"].contains("samples_per_vertex"));
+  EXPECT_FALSE(j["fit"]["held_as_decimated"]);
   EXPECT_TRUE(j["seconds"].contains("surface"));
   for (const std::string& bad :
        std::vector<std::string>{"--lambda 2", "--no-projection", "--strict", "--method unsharp",
@@ -198,13 +201,28 @@ TEST(CliEnhanceOptions, SmoothSurfaceFitsTheEstimate) {
     EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
     EXPECT_FALSE(std::filesystem::exists(dir.file("x.ply")));
   }
-  // A mesh with most faces below quality 0.3, as decimated meshes have.
+  const auto not_smooth = test::run_cli("enhance " + test::quoted_data_path("sphere_low.off") + " " +
+                                        test::quoted(dir.file("x.ply")) + " --assume-on-surface");
+  EXPECT_EQ(not_smooth.exit_code, 1);
+  EXPECT_NE(not_smooth.err.find("--assume-on-surface"), std::string::npos) << not_smooth.err;
+  // A mesh with most faces below quality 0.3, as decimated meshes have: held, with a warning
+  // naming the file; fitted with --assume-on-surface.
   const auto plate = dir.file("plate.off");
-  write_mesh(plate, test::sliver_plate(2, 8, 0.15, 0.4, 1));
-  const auto warned = test::run_cli("enhance " + test::quoted(plate) + " " + test::quoted(out) + " --surface smooth");
-  ASSERT_EQ(warned.exit_code, 0) << warned.err;
-  EXPECT_NE(warned.err.find("plate.off: "), std::string::npos) << warned.err;
-  EXPECT_NE(warned.err.find("as on decimated meshes"), std::string::npos) << warned.err;
+  const Mesh plate_mesh = test::sliver_plate(2, 8, 0.15, 0.4, 1);
+  write_mesh(plate, plate_mesh);
+  const auto held = test::run_cli("enhance " + test::quoted(plate) + " " + test::quoted(out) +
+                                  " --surface smooth --report " + test::quoted(report));
+  ASSERT_EQ(held.exit_code, 0) << held.err;
+  EXPECT_NE(held.err.find("plate.off: "), std::string::npos) << held.err;
+  EXPECT_NE(held.err.find("held every vertex"), std::string::npos) << held.err;
+  EXPECT_EQ(read_mesh(out).V, read_mesh(plate).V);
+  const nlohmann::json h = nlohmann::json::parse(test::read_text(report));
+  EXPECT_TRUE(h["fit"]["held_as_decimated"]);
+  EXPECT_GT(h["fit"]["poor_face_fraction"].get<double>(), 0.03);
+  const auto assumed = test::run_cli("--quiet enhance " + test::quoted(plate) + " " + test::quoted(out) +
+                                     " --surface smooth --assume-on-surface --report " + test::quoted(report));
+  ASSERT_EQ(assumed.exit_code, 0) << assumed.err;
+  EXPECT_FALSE(nlohmann::json::parse(test::read_text(report))["fit"]["held_as_decimated"]);
   const auto quiet = test::run_cli("enhance " + test::quoted_data_path("sphere_low.off") + " " + test::quoted(out) +
                                    " --surface smooth");
   EXPECT_EQ(quiet.err.find("decimated"), std::string::npos) << quiet.err;
