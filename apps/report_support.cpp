@@ -11,18 +11,19 @@
 
 namespace vertexflow::cli {
 
-ReportCurvatures report_curvatures(const Mesh& input, const Mesh& result, const Topology& topology) {
+ReportCurvatures report_curvatures(const Mesh& input, const Mesh& result, const Topology& topology,
+                                   const Topology* result_topology) {
   const CurvatureOptions options = CompareOptions{}.curvature;
   return {principal_curvatures(input.V, input.F, topology, options),
-          principal_curvatures(result.V, result.F, topology, options)};
+          principal_curvatures(result.V, result.F, result_topology ? *result_topology : topology, options)};
 }
 
 nlohmann::json flow_metrics(const Mesh& input, const Mesh& result, const Topology& topology,
-                            const ReportCurvatures& curvatures) {
+                            const ReportCurvatures& curvatures, const Topology* result_topology) {
   // The definitions of docs/metrics.md, through the same function as `vertexflow compare`: rho and
   // the edge-error CV use the input surface's curvature at each vertex's current position.
   ComparePrecomputed precomputed;
-  precomputed.result = {&topology, &curvatures.result};
+  precomputed.result = {result_topology ? result_topology : &topology, &curvatures.result};
   precomputed.input = {&topology, &curvatures.input};
   const MeshComparison c = compare_meshes(result, input, nullptr, CompareOptions{}, precomputed);
   // The flow's own unit (FlowReport::mean_edge_length is the same number).
@@ -34,7 +35,7 @@ nlohmann::json flow_metrics(const Mesh& input, const Mesh& result, const Topolog
   nlohmann::json report;
   report["vertices"] = input.V.rows();
   report["faces"] = F.rows();
-  report["flipped_faces"] = c.flipped_faces.value_or(0);
+  if (c.flipped_faces) report["flipped_faces"] = *c.flipped_faces;
   report["degenerate_faces"] = c.degenerate_faces_result;
   report["quality_input"] = to_json(c.quality_input);
   report["quality_result"] = to_json(c.quality_result);
@@ -54,7 +55,7 @@ nlohmann::json flow_metrics(const Mesh& input, const Mesh& result, const Topolog
   report["abs_mean_curvature_p95"] = {{"input", c.abs_mean_curvature_input.p95},
                                       {"result", c.abs_mean_curvature_result.p95}};
   report["volume_change_percent"] =
-      volume_before != 0 ? 100.0 * (signed_volume(result.V, F) - volume_before) / std::abs(volume_before) : 0.0;
+      volume_before != 0 ? 100.0 * (signed_volume(result.V, result.F) - volume_before) / std::abs(volume_before) : 0.0;
   return report;
 }
 

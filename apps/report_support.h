@@ -23,16 +23,20 @@ struct ReportCurvatures {
 };
 
 /// The curvatures of `input` and `result` (a flow result: the input's faces), with the faces'
-/// `topology`. Throws std::invalid_argument for a non-manifold mesh (curvature.h).
-ReportCurvatures report_curvatures(const Mesh& input, const Mesh& result, const Topology& topology);
+/// `topology`, or with `result_topology` for the result when given (its faces differ after
+/// edge flips). Throws std::invalid_argument for a non-manifold mesh (curvature.h).
+ReportCurvatures report_curvatures(const Mesh& input, const Mesh& result, const Topology& topology,
+                                   const Topology* result_topology = nullptr);
 
 /// Metrics (docs/metrics.md) of `result` (the input's faces, moved vertices) against `input`,
 /// with the faces' `topology` and the meshes' `curvatures` (report_curvatures): counts, flipped
 /// and degenerate faces, quality of both, displacement in mean input edge lengths,
 /// redistribution rho, edge-error CV and volume change. Throws CompareError (compare.h) for a
-/// mesh compare_meshes refuses.
+/// mesh compare_meshes refuses. With `result_topology` (the result's faces differ after edge
+/// flips) the per-face flip count is not applicable and is left out; the caller reports folds
+/// another way (edge_flips.h).
 nlohmann::json flow_metrics(const Mesh& input, const Mesh& result, const Topology& topology,
-                            const ReportCurvatures& curvatures);
+                            const ReportCurvatures& curvatures, const Topology* result_topology = nullptr);
 
 /// HTML report options whose title and labels name the two mesh files.
 HtmlReportOptions html_report_options(const std::filesystem::path& input, const std::filesystem::path& result);

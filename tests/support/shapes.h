@@ -22,6 +22,13 @@ Mesh torus(double R, double r, int around, int tube);
 /// The saddle z = (x^2 - y^2) / 2 over [-half, half]^2, n x n quads; normals up (+z).
 Mesh saddle(double half, int n);
 
+/// An n x n grid over [0, 1]^2 lifted to the roof z = -|x - y| / 2, whose ridge runs along the
+/// diagonal x = y through the vertices (i, i). Each square is split by the diagonal from
+/// (i + 1, j) to (i, j + 1) when `across`: the squares on the ridge are then cut across it, and
+/// their faces sag below the roof; otherwise by the diagonal from (i, j) to (i + 1, j + 1),
+/// which follows the ridge. Normals up (+z).
+Mesh roof(int n, bool across);
+
 /// Two triangles sharing only vertex 0 (a "bowtie"): the smallest non-manifold mesh.
 Mesh bowtie();
 
