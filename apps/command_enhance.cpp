@@ -45,6 +45,7 @@ struct EnhanceOptions {
   std::string surface = "input";
   SmoothFitOptions smooth;
   bool assume_on_surface = false;
+  std::string reference_method = "fit";
   bool edge_flips = false;
   int flip_cycles = 2;
   std::string method = "flow";
@@ -172,8 +173,9 @@ void warn_about_split(const ManifoldSplitCounts& split, const Progress& warn) {
 
 // The flow, with the caller's topology of mesh.F. Report: options, solver, guard, seconds.
 MethodRun run_flow(const Mesh& mesh, const Topology& topology, const FlowOptions& options, const Progress& phase,
-                   const Progress& warn) {
-  FlowResult result = vertex_flow(mesh.V, mesh.F, topology, options);
+                   const Progress& warn, const Mesh* reference = nullptr) {
+  FlowResult result = reference ? vertex_flow_on_reference(mesh.V, mesh.F, reference->V, reference->F, options)
+                                : vertex_flow(mesh.V, mesh.F, topology, options);
   const FlowReport& r = result.report;
   phase(fmt::format(
       "curvature {:.3f} s, assembly {:.3f} s, solve {:.3f} s, projection {:.3f} s, guard {:.3f} s; {} vertices "
@@ -371,6 +373,13 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
                       "Dense mesh of the true surface: fit the vertices to it (reference mode; fit.h) instead of "
                       "the paper's flow");
   command
+      ->add_option("--reference-method", o->reference_method,
+                   "With --reference: fit (the vertices fitted to it, leaving the input surface; fit.h) or flow (the "
+                   "paper's flow with its foot points, frames and curvature from the reference, the vertices on it; "
+                   "flow.h)")
+      ->check(CLI::IsMember({"fit", "flow"}))
+      ->capture_default_str();
+  command
       ->add_option("--surface", o->surface,
                    "What the vertices approximate without --reference: input (the paper's flow over the input "
                    "surface) or smooth (fit to a PN-triangle estimate of the smooth surface through the vertices; "
@@ -400,12 +409,18 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
   command->callback([o, &global, command, weight, smoothing] {
     const bool unsharp = o->method == "unsharp";
     const bool smooth = o->surface == "smooth";
-    const bool fit = !o->reference_file.empty();
-    if (fit && unsharp) throw std::runtime_error("--reference and --method unsharp exclude each other");
+    const bool on_reference = !o->reference_file.empty();
+    const bool reference_flow = on_reference && o->reference_method == "flow";
+    const bool fit = on_reference && !reference_flow;
+    if (command->count("--reference-method") > 0 && !on_reference)
+      throw std::runtime_error("--reference-method applies to --reference only");
+    if (on_reference && unsharp) throw std::runtime_error("--reference and --method unsharp exclude each other");
+    if (reference_flow && smooth) throw std::runtime_error("--surface smooth and --reference exclude each other");
     if (smooth && (fit || unsharp))
       throw std::runtime_error(std::string("--surface smooth and ") + (fit ? "--reference" : "--method unsharp") +
                                " exclude each other");
     if (fit) o->method = "reference";
+    if (reference_flow) o->method = "reference-flow";
     if (smooth) o->method = "smooth";
     for (const char* name : {"--lambda", "--mu", "--iterations", "--min-quality", "--no-projection", "--fairness",
                              "--feature-angle", "--solver", "--sliver-floor", "--sliver-stiffness"})
@@ -428,8 +443,11 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
       throw std::runtime_error("--max-rounds applies to --reference and --surface smooth only");
     if (!unsharp && (weight->count() > 0 || smoothing->count() > 0))
       throw std::runtime_error("--weight and --smoothing-iterations apply to --method unsharp only");
+    if (reference_flow && (command->count("--max-rounds") > 0 || o->edge_flips))
+      throw std::runtime_error(std::string(command->count("--max-rounds") > 0 ? "--max-rounds" : "--edge-flips") +
+                               " does not apply to --reference-method flow");
     std::vector<std::filesystem::path> inputs{o->input};
-    if (fit) inputs.emplace_back(o->reference_file);
+    if (on_reference) inputs.emplace_back(o->reference_file);
     check_outputs(inputs, {{o->output, /*mesh=*/true, /*may_replace_input=*/true}, {o->report_file}, {o->html_file}},
                   o->force);
     if (!o->pin_file.empty()) check_pin_file(o->pin_file);
@@ -461,7 +479,7 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     if (command->count("--max-rounds") > 0) o->smooth.fit.max_rounds = o->fit.max_rounds;
     if (o->assume_on_surface) o->smooth.max_poor_face_fraction = 1.0;
     Mesh reference;
-    if (fit) {
+    if (on_reference) {
       phase("reading " + o->reference_file);
       reference = read_mesh_with_warnings(o->reference_file, global);
     }
@@ -471,6 +489,9 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
                         reference.num_faces()));
     else if (smooth)
       phase(fmt::format("fitting {} vertices to the smooth-surface estimate through them", mesh.num_vertices()));
+    else if (reference_flow)
+      phase(fmt::format("flowing {} vertices over {} (lambda {}, mu {})", mesh.num_vertices(), o->reference_file,
+                        o->flow.weights.lambda, o->flow.weights.mu));
     else if (unsharp)
       phase(fmt::format("unsharp mask on {} vertices (weight {}, {} smoothing iterations)", mesh.num_vertices(),
                         o->unsharp.weight, o->unsharp.smoothing_iterations));
@@ -490,7 +511,7 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
         run = run_unsharp(mesh, o->unsharp, warn);
       } else {
         topology = build_topology(mesh.F, mesh.num_vertices());
-        run = run_flow(mesh, topology, o->flow, phase, warn);
+        run = run_flow(mesh, topology, o->flow, phase, warn, reference_flow ? &reference : nullptr);
       }
     } catch (const std::invalid_argument& e) {
       throw std::runtime_error(o->input + ": " + e.what());
@@ -527,7 +548,7 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
       report["method"] = o->method;
       report["input"] = o->input;
       report["output"] = o->output;
-      if (fit) {
+      if (on_reference) {
         report["reference"] = o->reference_file;
         // Two-sided, as issue 16 measures: the mean of both one-sided means, the RMS over both
         // directions, and the Hausdorff distance, in the meshes' units. The reference's tree and

@@ -120,7 +120,8 @@ struct FlowOptions {
   /// faces below 0.3: 89% of the vertices shortened, rho +0.00; now, with the solve's sliver
   /// term of flow_energy.h, 17.5% shortened and rho +0.13). The solve keeps no quality floor
   /// itself; without the floor, CAD creases produced 0.3% (fandisk) to 3% (spot) of faces
-  /// below 0.3. The faces below min_quality are also the slivers of F_sliver. 0 disables it (only flipped and degenerate faces are repaired).
+  /// below 0.3. The faces below min_quality are also the slivers of F_sliver. 0 disables it (only flipped and
+  /// degenerate faces are repaired).
   double min_quality = 0.3;
   /// See min_quality: the fraction of its input quality below which a sliver (a face that
   /// starts below min_quality) may not fall. 1 keeps every sliver at least as good as its
@@ -179,5 +180,20 @@ FlowResult vertex_flow(const Vertices& V, const Faces& F, const FlowOptions& opt
 /// may need it too: the flow builds none of its own. Throws std::invalid_argument if the
 /// topology was built for another vertex or face count.
 FlowResult vertex_flow(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options = {});
+
+/// The paper's flow with the true surface S known (issue 16): section 4.1 measures F_sd against S
+/// and uses the input only "since S is usually unavailable". Here every solve takes from S, at
+/// each vertex's closest point on it (its foot point), the anchor p_i and frame of F_sd and the
+/// curvature tensor of F_em (S's principal_curvatures, options.curvature, blended over the foot
+/// point's face by its barycentric weights and re-diagonalised in the plane normal to the
+/// blended normal), and the projection puts the vertices on S instead of on the input. So the
+/// vertices redistribute by S's curvature and stay on S: the distance to S is that of a mesh
+/// inscribed in S, like the input's, not lower (fit_to_reference, fit.h, lowers it). Features,
+/// boundaries, pins and the guard as vertex_flow (the guard's shortened vertices are not
+/// projected). (VS, FS) is any triangle mesh of S, in the input's units. Throws as vertex_flow,
+/// and std::invalid_argument for an empty S, a non-finite coordinate of S, or a mesh that is
+/// not manifold and oriented (the reference flow has no manifold split).
+FlowResult vertex_flow_on_reference(const Vertices& V, const Faces& F, const Vertices& VS, const Faces& FS,
+                                    const FlowOptions& options = {});
 
 }  // namespace vertexflow

@@ -7,12 +7,15 @@
 #include "flow_solver.h"
 #include "guard.h"
 #include "surface_projection.h"
+#include "vertexflow/curvature.h"
+#include "vertexflow/distance.h"
 #include "vertexflow/manifold_split.h"
 #include "vertexflow/timing.h"
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <optional>
 #include <stdexcept>
 #include <string>
 
@@ -75,6 +78,77 @@ FlowResult flow_on_manifold_split(const Vertices& V, const Faces& F, const Topol
   return result;
 }
 
+// The rounds of vertex_flow on a manifold, oriented mesh with valid options: on the input, or
+// with frames, curvature and projection from the reference S (vertex_flow_on_reference).
+FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options,
+                       const Mesh* reference) {
+  const Index n = static_cast<Index>(V.rows());
+  FlowResult result;
+  FlowReport& report = result.report;
+
+  const FlowSetup setup = prepare_flow(V, F, topology, options);
+  std::optional<ReferenceSurface> surface;
+  if (reference) {  // S in the flow's normalised units
+    const Vertices VS = (reference->V.rowwise() - setup.centroid) / setup.scale;
+    surface.emplace(ReferenceSurface{
+        DistanceQuery(VS, reference->F),
+        principal_curvatures(VS, reference->F, build_topology(reference->F, VS.rows()), options.curvature)});
+  }
+  FlowOptions guard_options = options;
+  if (surface) guard_options.project_to_input = false;  // shortened vertices are not projected onto S
+  const std::vector<char>& fixed = setup.fixed;
+  const Vertices& input = setup.input;
+  report.fixed_vertices = static_cast<Index>(std::count(fixed.begin(), fixed.end(), 1));
+  report.mean_edge_length = setup.mean_edge_length;
+
+  Vertices X = input;
+  // One solver for all rounds: the connectivity is fixed, so its ordering is computed once.
+  FlowSystemSolver solver(topology, fixed, options.solver, options.solver_tolerance);
+  const GuardCriteria criteria = guard_criteria(input, F, options.min_quality, options.sliver_floor);
+  std::vector<char> shortened(static_cast<std::size_t>(n), 0);
+  for (int round = 0; round < options.iterations; ++round) {
+    const Vertices start_of_round = X;
+    // One solve: minimise the energy for positions X, frozen curvature of X.
+    auto start = Clock::now();
+    const FlowFrame frame = surface ? flow_frame_on_reference(X, F, topology, options, setup.sliver_faces, *surface)
+                                    : flow_frame(X, F, topology, options, setup.sliver_faces);
+    report.d = frame.d;
+    report.seconds_curvature += seconds_since(start);
+    X = solver.solve(frame, options.weights, report);
+    if (!X.allFinite()) throw std::runtime_error("vertex flow: the solver diverged");
+    if (options.project_to_input) {
+      start = Clock::now();
+      std::vector<Index> free_rows;
+      for (Index i = 0; i < n; ++i) {
+        if (!fixed[static_cast<std::size_t>(i)]) free_rows.push_back(i);
+      }
+      if (surface) {
+        const std::vector<ClosestPoint> feet = surface->query.closest_points(X);
+        for (const Index i : free_rows) X.row(i) = feet[static_cast<std::size_t>(i)].point.transpose();
+      } else {
+        project_near_vertices(X, free_rows, input, F, topology, setup.features);
+      }
+      report.seconds_projection += seconds_since(start);
+    }
+    // Guarded after every round, not only the last: the next round's curvature is estimated on
+    // X, and on the unguarded fandisk after three rounds (671 flipped or degenerate faces) it
+    // reached 1e15 per mean edge length, which made the normal matrix numerically indefinite.
+    start = Clock::now();
+    guard(X, start_of_round, input, criteria, fixed, topology, setup.features, guard_options, shortened, report);
+    report.seconds_guard += seconds_since(start);
+  }
+
+  report.limited_vertices = static_cast<Index>(std::count(shortened.begin(), shortened.end(), 1));
+  report.d *= setup.scale;
+
+  result.V = (X * setup.scale).rowwise() + setup.centroid;
+  // Fixed vertices are returned bit for bit.
+  for (Index i = 0; i < n; ++i) {
+    if (fixed[static_cast<std::size_t>(i)]) result.V.row(i) = V.row(i);
+  }
+  return result;
+}
+
 }  // namespace
 
 FlowResult vertex_flow(const Vertices& V, const Faces& F, const FlowOptions& options) {
@@ -83,7 +157,12 @@ FlowResult vertex_flow(const Vertices& V, const Faces& F, const FlowOptions& opt
   return vertex_flow(V, F, build_topology(F, static_cast<Index>(V.rows())), options);
 }
 
-FlowResult vertex_flow(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options) {
+namespace {
+
+// vertex_flow's checks, then the rounds (on the manifold split of a non-manifold mesh when
+// options allow), on the input or on the reference.
+FlowResult check_then(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options,
+                      const Mesh* reference) {
   const Index n = static_cast<Index>(V.rows());
   validate_flow_options(options, n);
   if (n == 0 || F.rows() == 0) throw std::invalid_argument("vertex flow: the mesh is empty");
@@ -103,55 +182,29 @@ FlowResult vertex_flow(const Vertices& V, const Faces& F, const Topology& topolo
                                                          : describe_non_manifold(topology)));
     return flow_on_manifold_split(V, F, topology, options);
   }
-  FlowResult result;
-  FlowReport& report = result.report;
+  return flow_rounds(V, F, topology, options, reference);
+}
 
-  const FlowSetup setup = prepare_flow(V, F, topology, options);
-  const std::vector<char>& fixed = setup.fixed;
-  const Vertices& input = setup.input;
-  report.fixed_vertices = static_cast<Index>(std::count(fixed.begin(), fixed.end(), 1));
-  report.mean_edge_length = setup.mean_edge_length;
+}  // namespace
 
-  Vertices X = input;
-  // One solver for all rounds: the connectivity is fixed, so its ordering is computed once.
-  FlowSystemSolver solver(topology, fixed, options.solver, options.solver_tolerance);
-  const GuardCriteria criteria = guard_criteria(input, F, options.min_quality, options.sliver_floor);
-  std::vector<char> shortened(static_cast<std::size_t>(n), 0);
-  for (int round = 0; round < options.iterations; ++round) {
-    const Vertices start_of_round = X;
-    // One solve: minimise the energy for positions X, frozen curvature of X.
-    auto start = Clock::now();
-    const FlowFrame frame = flow_frame(X, F, topology, options, setup.sliver_faces);
-    report.d = frame.d;
-    report.seconds_curvature += seconds_since(start);
-    X = solver.solve(frame, options.weights, report);
-    if (!X.allFinite()) throw std::runtime_error("vertex flow: the solver diverged");
-    if (options.project_to_input) {
-      start = Clock::now();
-      std::vector<Index> free_rows;
-      for (Index i = 0; i < n; ++i) {
-        if (!fixed[static_cast<std::size_t>(i)]) free_rows.push_back(i);
-      }
-      project_near_vertices(X, free_rows, input, F, topology, setup.features);
-      report.seconds_projection += seconds_since(start);
-    }
-    // Guarded after every round, not only the last: the next round's curvature is estimated on
-    // X, and on the unguarded fandisk after three rounds (671 flipped or degenerate faces) it
-    // reached 1e15 per mean edge length, which made the normal matrix numerically indefinite.
-    start = Clock::now();
-    guard(X, start_of_round, input, criteria, fixed, topology, setup.features, options, shortened, report);
-    report.seconds_guard += seconds_since(start);
-  }
+FlowResult vertex_flow(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options) {
+  return check_then(V, F, topology, options, nullptr);
+}
 
-  report.limited_vertices = static_cast<Index>(std::count(shortened.begin(), shortened.end(), 1));
-  report.d *= setup.scale;
-
-  result.V = (X * setup.scale).rowwise() + setup.centroid;
-  // Fixed vertices are returned bit for bit.
-  for (Index i = 0; i < n; ++i) {
-    if (fixed[static_cast<std::size_t>(i)]) result.V.row(i) = V.row(i);
-  }
-  return result;
+FlowResult vertex_flow_on_reference(const Vertices& V, const Faces& F, const Vertices& VS, const Faces& FS,
+                                    const FlowOptions& options) {
+  if (VS.rows() == 0 || FS.rows() == 0)
+    throw std::invalid_argument("vertex flow on a reference: the reference is empty");
+  if (!VS.allFinite())
+    throw std::invalid_argument("vertex flow on a reference: a vertex of the reference has a non-finite coordinate");
+  FlowOptions strict = options;
+  strict.refuse_non_manifold = true;  // no manifold split: refuse rather than flow a split
+  if (V.rows() == 0 || F.rows() == 0) throw std::invalid_argument("vertex flow: the mesh is empty");
+  const Topology topology = build_topology(F, static_cast<Index>(V.rows()));
+  Mesh reference;
+  reference.V = VS;
+  reference.F = FS;
+  return check_then(V, F, topology, strict, &reference);
 }
 
 }  // namespace vertexflow

@@ -1,7 +1,11 @@
 #include "flow_setup.h"
 
+#include "numerics/parallel.h"
+
 #include "vertexflow/quality.h"
 #include "vertexflow/statistics.h"
+
+#include <Eigen/Eigenvalues>
 
 #include <algorithm>
 #include <cmath>
@@ -79,6 +83,49 @@ FlowFrame flow_frame(const Vertices& X, const Faces& F, const Topology& topology
   frame.d = robust_radius(frame.curvature, options.d_percentile);
   if (!sliver_faces.empty())
     frame.sliver_stiffness = sliver_stiffness(X, F, sliver_faces, static_cast<Index>(X.rows()));
+  return frame;
+}
+
+FlowFrame flow_frame_on_reference(const Vertices& X, const Faces& F, const Topology& topology,
+                                  const FlowOptions& options, const std::vector<Index>& sliver_faces,
+                                  const ReferenceSurface& surface) {
+  FlowFrame frame = flow_frame(X, F, topology, options, sliver_faces);
+  const std::vector<ClosestPoint> feet = surface.query.closest_points(X);
+  const Faces& FS = surface.query.faces();
+  const Curvature& S = surface.curvature;
+  Curvature& c = frame.curvature;
+  parallel_for_index(X.rows(), [&](Index i) {
+    const ClosestPoint& foot = feet[static_cast<std::size_t>(i)];
+    frame.P.row(i) = foot.point.transpose();
+    // The shape operators of the face's corners, blended: sum b_k (k1 T1 T1^T + k2 T2 T2^T)_k.
+    Eigen::Matrix3d shape = Eigen::Matrix3d::Zero();
+    Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+    for (int k = 0; k < 3; ++k) {
+      const Index v = FS(foot.face, k);
+      const Eigen::Vector3d t1 = S.T1.row(v).transpose(), t2 = S.T2.row(v).transpose();
+      shape += foot.barycentric[k] * (S.k1[v] * t1 * t1.transpose() + S.k2[v] * t2 * t2.transpose());
+      normal += foot.barycentric[k] * S.N.row(v).transpose();
+    }
+    if (!(normal.norm() > 0)) return;  // opposite normals cancel: keep X's own frame
+    normal.normalize();
+    const Eigen::Matrix3d tangent = Eigen::Matrix3d::Identity() - normal * normal.transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(tangent * shape * tangent);
+    // Of the three eigenvectors, the one closest to the normal has eigenvalue 0; the others are
+    // the principal directions.
+    int along = 0;
+    for (int k = 1; k < 3; ++k)
+      if (std::abs(eigen.eigenvectors().col(k).dot(normal)) > std::abs(eigen.eigenvectors().col(along).dot(normal)))
+        along = k;
+    const int a = along == 0 ? 1 : 0, b = along == 2 ? 1 : 2;                            // the other two, a < b
+    Eigen::Vector3d t1 = eigen.eigenvectors().col(b), t2 = eigen.eigenvectors().col(a);  // ascending values
+    if (t1.cross(t2).dot(normal) < 0) t2 = -t2;
+    c.k1[i] = eigen.eigenvalues()[b];
+    c.k2[i] = eigen.eigenvalues()[a];
+    c.T1.row(i) = t1.transpose();
+    c.T2.row(i) = t2.transpose();
+    c.N.row(i) = normal.transpose();
+  });
+  frame.d = robust_radius(c, options.d_percentile);
   return frame;
 }
 

@@ -3,6 +3,8 @@
 // up the solver's problems through these, so that they test the problem the flow solves.
 #pragma once
 
+#include "vertexflow/curvature.h"
+#include "vertexflow/distance.h"
 #include "vertexflow/features.h"
 #include "vertexflow/flow.h"
 #include "vertexflow/flow_energy.h"
@@ -38,5 +40,19 @@ FlowSetup prepare_flow(const Vertices& V, const Faces& F, const Topology& topolo
 /// stiffness at X for `sliver_faces` (none if empty).
 FlowFrame flow_frame(const Vertices& X, const Faces& F, const Topology& topology, const FlowOptions& options,
                      const std::vector<Index>& sliver_faces = {});
+
+/// The true surface S of vertex_flow_on_reference, in the flow's normalised units: its
+/// closest-point queries and its own curvature.
+struct ReferenceSurface {
+  DistanceQuery query;
+  Curvature curvature;
+};
+
+/// The frame of flow_frame with the anchors P and the curvature (k1, k2, T1, T2, N) taken from S
+/// at the foot points of X (flow.h, vertex_flow_on_reference); the areas and d from X's and
+/// S's curvature as flow_frame.
+FlowFrame flow_frame_on_reference(const Vertices& X, const Faces& F, const Topology& topology,
+                                  const FlowOptions& options, const std::vector<Index>& sliver_faces,
+                                  const ReferenceSurface& surface);
 
 }  // namespace vertexflow

@@ -130,16 +130,27 @@ TEST(CliEnhanceOptions, SliverFloorBoundsHowFarSliversMayFall) {
   }
 }
 
+// sphere.off scaled to sphere_low.off's radius (0.289; the two are not the same sphere) and
+// written to `path`: a dense reference for sphere_low.
+Mesh write_dense_sphere_for_sphere_low(const std::filesystem::path& path) {
+  const Mesh low = read_mesh(test::data_path("sphere_low.off"));
+  Mesh dense = read_mesh(test::data_path("sphere.off"));
+  dense.V *= low.V.rowwise().norm().mean();
+  write_mesh(path, dense);
+  return dense;
+}
+
 // Reference mode: the CLI's output is fit_to_reference's, the report holds the fit's rounds and
 // both meshes' two-sided distances to the reference, and flow-only options are refused.
 TEST(CliEnhanceOptions, ReferenceFitsToTheDenseMesh) {
   const Mesh mesh = read_mesh(test::data_path("sphere_low.off"));
-  const Mesh dense = read_mesh(test::data_path("sphere.off"));
   test::ScratchDir dir("cli-enhance-reference");
+  const auto dense_path = dir.file("dense.off");
+  const Mesh dense = write_dense_sphere_for_sphere_low(dense_path);
   const auto out = dir.file("out.ply"), report = dir.file("report.json");
-  const auto r = test::run_cli("--quiet enhance " + test::quoted_data_path("sphere_low.off") + " " + test::quoted(out) +
-                               " --reference " + test::quoted_data_path("sphere.off") + " --max-rounds 3 --report " +
-                               test::quoted(report));
+  const auto r =
+      test::run_cli("--quiet enhance " + test::quoted_data_path("sphere_low.off") + " " + test::quoted(out) +
+                    " --reference " + test::quoted(dense_path) + " --max-rounds 3 --report " + test::quoted(report));
   ASSERT_EQ(r.exit_code, 0) << r.err;
   FitOptions options;
   options.max_rounds = 3;
@@ -156,7 +167,7 @@ TEST(CliEnhanceOptions, ReferenceFitsToTheDenseMesh) {
   for (const std::string bad : {"--lambda 2", "--no-projection", "--strict", "--method unsharp"}) {
     const auto refused =
         test::run_cli("enhance " + test::quoted_data_path("sphere_low.off") + " " + test::quoted(dir.file("x.ply")) +
-                      " --reference " + test::quoted_data_path("sphere.off") + " " + bad);
+                      " --reference " + test::quoted(dense_path) + " " + bad);
     EXPECT_EQ(refused.exit_code, 1) << bad;
     EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
     EXPECT_FALSE(std::filesystem::exists(dir.file("x.ply")));
@@ -165,6 +176,35 @@ TEST(CliEnhanceOptions, ReferenceFitsToTheDenseMesh) {
                                      test::quoted(dir.file("x.ply")) + " --reference /nonexistent/dense.off");
   EXPECT_EQ(missing.exit_code, 1);
   EXPECT_NE(missing.err.find("/nonexistent/dense.off"), std::string::npos) << missing.err;
+}
+
+// --reference-method flow: the CLI's output is the library's vertex_flow_on_reference, the report
+// names the method, and options that do not apply are refused.
+TEST(CliEnhanceOptions, ReferenceMethodFlowRunsTheFlowOnTheReference) {
+  const Mesh mesh = read_mesh(test::data_path("sphere_low.off"));
+  test::ScratchDir dir("cli-enhance-reference-flow");
+  const auto dense_path = dir.file("dense.off");
+  const Mesh dense = write_dense_sphere_for_sphere_low(dense_path);
+  const auto out = dir.file("out.ply"), report = dir.file("report.json");
+  const auto r = test::run_cli("--quiet enhance " + test::quoted_data_path("sphere_low.off") + " " + test::quoted(out) +
+                               " --reference " + test::quoted(dense_path) +
+                               " --reference-method flow --lambda 2 --report " + test::quoted(report));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  FlowOptions options;
+  options.weights.lambda = 2;
+  EXPECT_EQ(read_mesh(out).V, vertex_flow_on_reference(mesh.V, mesh.F, dense.V, dense.F, options).V);
+  const nlohmann::json j = nlohmann::json::parse(test::read_text(report));
+  EXPECT_EQ(j["method"], "reference-flow");
+  EXPECT_TRUE(j.contains("distance_to_reference"));
+  for (const std::string& bad :
+       std::vector<std::string>{" --reference-method flow", " --reference-method flow --reference " +
+                                                                test::quoted(dense_path) + " --max-rounds 2"}) {
+    const auto refused = test::run_cli("enhance " + test::quoted_data_path("sphere_low.off") + " " +
+                                       test::quoted(dir.file("x.ply")) + bad);
+    EXPECT_EQ(refused.exit_code, 1) << bad;
+    EXPECT_EQ(std::count(refused.err.begin(), refused.err.end(), '\n'), 1) << refused.err;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("x.ply")));
+  }
 }
 
 // --edge-flips: reference mode on a roof whose ridge the coarse faces cut across, fitted and
