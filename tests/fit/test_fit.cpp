@@ -12,7 +12,6 @@
 #include "vertexflow/topology.h"
 
 #include <gtest/gtest.h>
-#include <tbb/global_control.h>
 
 #include <cmath>
 #include <iostream>
@@ -131,15 +130,10 @@ TEST(FitToReference, InvariantAndDeterministic) {
   Mesh reference = test::torus(1.0, 0.4, 240, 96);
   const Eigen::Matrix3d turn = Eigen::AngleAxisd(0.05, Eigen::Vector3d::UnitZ()).toRotationMatrix();
   reference.V = (reference.V * turn.transpose()).eval();
-  FitResult one, two;
-  {
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
-    one = fit_to_reference(coarse.V, coarse.F, reference.V, reference.F);
-  }
-  {
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
-    two = fit_to_reference(coarse.V, coarse.F, reference.V, reference.F);
-  }
+  const FitResult one =
+      test::with_threads(1, [&] { return fit_to_reference(coarse.V, coarse.F, reference.V, reference.F); });
+  const FitResult two =
+      test::with_threads(2, [&] { return fit_to_reference(coarse.V, coarse.F, reference.V, reference.F); });
   EXPECT_EQ(one.V, two.V);
   expect_promises_kept(coarse, one, {});
   EXPECT_GT((one.V - coarse.V).rowwise().norm().mean(), 0.0036);  // measured 0.0090; difference 9e-8

@@ -12,7 +12,6 @@
 #include "vertexflow/simplify.h"
 
 #include <gtest/gtest.h>
-#include <tbb/global_control.h>
 
 #include <iostream>
 
@@ -134,15 +133,8 @@ TEST(SmoothFit, MeshOfPlanesAndCreasesStays) {
 
 TEST(SmoothFit, InvariantAndDeterministic) {
   const Mesh coarse = test::torus(1.0, 0.4, 24, 12);
-  FitResult one, two;
-  {
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
-    one = fit_to_smooth_surface(coarse.V, coarse.F);
-  }
-  {
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
-    two = fit_to_smooth_surface(coarse.V, coarse.F);
-  }
+  const FitResult one = test::with_threads(1, [&] { return fit_to_smooth_surface(coarse.V, coarse.F); });
+  const FitResult two = test::with_threads(2, [&] { return fit_to_smooth_surface(coarse.V, coarse.F); });
   EXPECT_EQ(one.V, two.V);
   const double moved = (one.V - coarse.V).rowwise().norm().mean();
   const Eigen::Matrix3d R = Eigen::AngleAxisd(0.7, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();

@@ -11,7 +11,6 @@
 #include "vertexflow/io.h"
 
 #include <gtest/gtest.h>
-#include <tbb/global_control.h>
 
 #include <iostream>
 
@@ -56,15 +55,10 @@ TEST(FlowOnReference, InvariantAndDeterministic) {
   // (Not the regular torus of shapes.h: on its symmetric sampling the plain flow itself differs by
   // 4e-3 after a rotation. Not sphere_low over sphere: they are different spheres.)
   const Mesh coarse = read_mesh(test::data_path("bunny_uniform.off")), dense = read_mesh(test::data_path("bunny.off"));
-  FlowResult one, two;
-  {
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
-    one = vertex_flow_on_reference(coarse.V, coarse.F, dense.V, dense.F);
-  }
-  {
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
-    two = vertex_flow_on_reference(coarse.V, coarse.F, dense.V, dense.F);
-  }
+  const FlowResult one =
+      test::with_threads(1, [&] { return vertex_flow_on_reference(coarse.V, coarse.F, dense.V, dense.F); });
+  const FlowResult two =
+      test::with_threads(2, [&] { return vertex_flow_on_reference(coarse.V, coarse.F, dense.V, dense.F); });
   EXPECT_EQ(one.V, two.V);
   const double moved = (one.V - coarse.V).rowwise().norm().maxCoeff();
   const Eigen::Matrix3d R = Eigen::AngleAxisd(1.1, Eigen::Vector3d(2, 1, -1).normalized()).toRotationMatrix();

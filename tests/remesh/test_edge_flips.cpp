@@ -12,7 +12,6 @@
 #include "vertexflow/topology.h"
 
 #include <gtest/gtest.h>
-#include <tbb/global_control.h>
 
 #include <iostream>
 
@@ -84,15 +83,10 @@ TEST(EdgeFlips, FittedBunnyComesCloserAndKeepsThePromises) {
 TEST(EdgeFlips, InvariantAndDeterministic) {
   const Mesh coarse = test::roof(10, true);
   const Mesh exact = test::roof(40, false);
-  EdgeFlipResult one, two;
-  {
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 1);
-    one = flip_edges_toward(coarse.V, coarse.F, DistanceQuery(exact.V, exact.F));
-  }
-  {
-    tbb::global_control limit(tbb::global_control::max_allowed_parallelism, 2);
-    two = flip_edges_toward(coarse.V, coarse.F, DistanceQuery(exact.V, exact.F));
-  }
+  const EdgeFlipResult one =
+      test::with_threads(1, [&] { return flip_edges_toward(coarse.V, coarse.F, DistanceQuery(exact.V, exact.F)); });
+  const EdgeFlipResult two =
+      test::with_threads(2, [&] { return flip_edges_toward(coarse.V, coarse.F, DistanceQuery(exact.V, exact.F)); });
   EXPECT_EQ(one.F, two.F);
   const Eigen::Matrix3d R = Eigen::AngleAxisd(0.9, Eigen::Vector3d(1, -2, 1).normalized()).toRotationMatrix();
   auto move = [&](const Vertices& X) -> Vertices {

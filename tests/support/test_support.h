@@ -3,6 +3,8 @@
 
 #include "vertexflow/mesh.h"
 
+#include <tbb/global_control.h>
+
 #include <filesystem>
 #include <string>
 #include <vector>
@@ -17,6 +19,13 @@
 #endif
 
 namespace vertexflow::test {
+
+/// compute() with TBB limited to `threads` threads: determinism tests compare 1 and 2.
+template <class Compute>
+auto with_threads(int threads, Compute&& compute) {
+  tbb::global_control limit(tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(threads));
+  return compute();
+}
 
 /// A mesh bundled in data/ (VERTEXFLOW_DATA_DIR is set by tests/CMakeLists.txt).
 inline std::filesystem::path data_path(const std::string& name) {
