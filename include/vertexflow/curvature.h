@@ -97,4 +97,30 @@ Curvature principal_curvatures(const Vertices& V, const Faces& F, const Topology
 /// Convenience overload that builds the topology.
 Curvature principal_curvatures(const Vertices& V, const Faces& F, const CurvatureOptions& options = {});
 
+/// The derivative of curvature (Rusinkiewicz 2004, section 5): per vertex the symmetric 2 x 2 x 2
+/// tensor C(x, y, z) = (D_x II)(y, z), the change of the second fundamental form II along the
+/// tangent x, which line drawings need (ridges and valleys: D_T1 k1 = C(T1, T1, T1) = 0;
+/// suggestive contours: the directional derivative of the radial curvature). Same sign
+/// convention as the curvature above (a convex bump with outward normals has C(x, x, x) < 0
+/// going outwards from its peak); units 1 / length^2. Fitted per face from the differences of
+/// its corners' II along its edges (least squares in the Frobenius norm), transported into each
+/// vertex's frame and averaged with the corner areas, as the curvature itself.
+struct CurvatureDerivative {
+  /// Per vertex (#V x 4): C(T1, T1, T1), C(T1, T1, T2), C(T1, T2, T2), C(T2, T2, T2), in the
+  /// principal frame (T1, T2) of the Curvature it was estimated from.
+  Eigen::Matrix<double, Eigen::Dynamic, 4, Eigen::RowMajor> C;
+
+  /// C(x, y, z) at vertex i, for vectors x, y, z given in `curvature`'s frame as (x . T1, x . T2)
+  /// and so on.
+  [[nodiscard]] double evaluate(Index i, const Eigen::Vector2d& x, const Eigen::Vector2d& y,
+                                const Eigen::Vector2d& z) const;
+};
+
+/// The derivative of `curvature` (principal_curvatures of the same mesh, any options). Parallel,
+/// the same result for any thread count. Vertices without a usable face (degenerate, or folded
+/// against the vertex normal) get 0. Throws std::invalid_argument when `curvature` or `topology`
+/// is for another vertex count.
+CurvatureDerivative curvature_derivative(const Vertices& V, const Faces& F, const Topology& topology,
+                                         const Curvature& curvature);
+
 }  // namespace vertexflow
