@@ -16,20 +16,28 @@ def read(name):
 # --- enhance: the same vertices as `vertexflow enhance`, bit for bit -----------------------------
 
 
-@pytest.mark.parametrize("name", ["bunny_uniform.off", "fandisk.off", "max-planck-5k.obj"])
-def test_enhance_matches_cli_bit_for_bit(tmp_path, name):
+# Three with the defaults (conjugate gradients: block-Jacobi on bunny_uniform and max-planck-5k,
+# multilevel on fandisk), and a direct (CHOLMOD) solve: in Python, numpy has loaded Debian's
+# threaded OpenBLAS, which CHOLMOD then uses instead of the CLI's serial one (flow.h: one thread).
+@pytest.mark.parametrize("name, cli_args, kwargs", [
+    ("bunny_uniform.off", [], {}),
+    ("fandisk.off", [], {}),
+    ("max-planck-5k.obj", [], {}),
+    ("spot.obj", ["--solver", "direct", "--lambda", "0.5"], {"solver": "direct", "lam": 0.5}),
+])
+def test_enhance_matches_cli_bit_for_bit(tmp_path, name, cli_args, kwargs):
     out = tmp_path / "cli.ply"  # PLY keeps float64 exactly
-    run_cli("-q", "enhance", DATA / name, out)
+    run_cli("-q", "enhance", DATA / name, out, *cli_args)
     V_cli, F_cli = vertexflow.read_mesh(out)
     V, F = read(name)
-    V_out, report = vertexflow.enhance(V, F)
+    V_out, report = vertexflow.enhance(V, F, **kwargs)
     assert V_out.dtype == np.float64 and V_out.shape == V.shape
     assert V_out.tobytes() == V_cli.tobytes()
     assert np.array_equal(F, F_cli)
     # The flow did something: vertices moved.
     assert np.abs(V_out - V).max() > 0
     assert report["method"] == "flow"
-    assert report["options"]["lambda"] == 1.0
+    assert report["options"]["lambda"] == kwargs.get("lam", 1.0)
     assert {"solver", "guard", "seconds"} <= report.keys()
 
 
@@ -228,3 +236,27 @@ def test_gil_is_released_during_enhance():
         count += 1
     worker.join()
     assert count > 100
+
+
+# --- the stub ----------------------------------------------------------------------------------------
+
+
+def test_stub_lists_every_function_with_the_librarys_defaults():
+    import ast
+    import pathlib
+
+    stub = ast.parse((pathlib.Path(vertexflow.__file__).parent / "vertexflow.pyi").read_text())
+    functions = {n.name: n for n in stub.body if isinstance(n, ast.FunctionDef)}
+    public = {n for n in dir(vertexflow) if not n.startswith("_") and callable(getattr(vertexflow, n))}
+    assert public - {"PrincipalCurvatures"} == functions.keys()
+    enhance = functions["enhance"].args
+    defaults = {a.arg: ast.literal_eval(d) for a, d in zip(enhance.kwonlyargs, enhance.kw_defaults)}
+    assert set(vertexflow.FLOW_OPTIONS) <= defaults.keys()
+    V, F = read("spot.obj")
+    options = vertexflow.enhance(V, F)[1]["options"]
+    library = dict(options, lam=options["lambda"], pins=None, normal_weighting=options["curvature"]["normal_weighting"],
+                   curvature_smoothing_rounds=options["curvature"]["smoothing_rounds"])
+    for name in vertexflow.FLOW_OPTIONS:
+        assert defaults[name] == library[name], name
+    # Every keyword of the stub is accepted (a misspelt one raises TypeError).
+    vertexflow.enhance(V, F, **{k: v for k, v in defaults.items() if k not in ("reference",)})
