@@ -2,7 +2,7 @@
 """Throughput, in meshes per second, of `vertexflow batch --jobs 1`, `--jobs 2` and
 examples/dask_batch.py on a 2-worker LocalCluster, over the 20 small data meshes of the Python
 tests (python/tests/conftest.py: the 17 bundled meshes below 12k vertices and 3 converted
-copies), each file with one library thread (--threads 1), metrics on (the default).
+copies), each file with one library thread (--threads 1), metrics on (the default) or off (--no-metrics).
 
     PYTHONPATH=build/python python3 bench/batch_throughput.py [--cli build/bin/vertexflow] [--repeats 3]
 
@@ -39,21 +39,23 @@ def main():
     parser = argparse.ArgumentParser()
     parser.add_argument("--cli", default=os.path.join(HERE, "..", "build", "bin", "vertexflow"))
     parser.add_argument("--repeats", type=int, default=3)
+    parser.add_argument("--no-metrics", action="store_true", help="pass --no-metrics to all three")
     args = parser.parse_args()
+    extra = ["--no-metrics"] if args.no_metrics else []
     with tempfile.TemporaryDirectory() as tmp:
         data = pathlib.Path(tmp) / "data"
         make_dataset(data)
         out = pathlib.Path(tmp) / "out"
         settings = {
-            "batch --jobs 1": lambda: run([args.cli, "-q", "batch", data, out, "--jobs", "1", "--threads", "1", "--force"],
-                                          out / "batch_summary.json"),
-            "batch --jobs 2": lambda: run([args.cli, "-q", "batch", data, out, "--jobs", "2", "--threads", "1", "--force"],
-                                          out / "batch_summary.json"),
+            "batch --jobs 1": lambda: run([args.cli, "-q", "batch", data, out, "--jobs", "1", "--threads", "1", "--force",
+                                           *extra], out / "batch_summary.json"),
+            "batch --jobs 2": lambda: run([args.cli, "-q", "batch", data, out, "--jobs", "2", "--threads", "1", "--force",
+                                           *extra], out / "batch_summary.json"),
             "dask LocalCluster, 2 workers": lambda: run(
                 [sys.executable, os.path.join(HERE, "..", "examples", "dask_batch.py"), data, out, "--workers", "2",
-                 "--threads", "1", "--force", "--summary", pathlib.Path(tmp) / "dask.json"], pathlib.Path(tmp) / "dask.json"),
+                 "--threads", "1", "--force", "--summary", pathlib.Path(tmp) / "dask.json", *extra], pathlib.Path(tmp) / "dask.json"),
         }
-        print(f"20 meshes, {os.cpu_count()} cores, load average before {os.getloadavg()[0]:.2f}; median of {args.repeats}")
+        print(f"20 meshes, metrics {'off' if extra else 'on'}, {os.cpu_count()} cores, load average before {os.getloadavg()[0]:.2f}; median of {args.repeats}")
         for name, setting in settings.items():
             runs = [setting() for _ in range(args.repeats)]
             files = statistics.median(r[0] for r in runs)

@@ -100,6 +100,7 @@ def render(
     displacement_reference: _Vertices | None = None,
     color_bar: bool = True,
     samples: int = 4,
+    threads: int = 0,
 ) -> npt.NDArray[np.uint8]: ...
 def enhance_file(
     input: _Path,

@@ -520,7 +520,8 @@ py::tuple py_remesh(const py::handle& V, const py::handle& F, Index target_verti
 
 py::array py_render(const py::handle& V, const py::handle& F, int width, int height, const std::string& view,
                     const std::string& color, const std::string& shading, bool wireframe, double azimuth,
-                    double elevation, const py::object& displacement_reference, bool color_bar, int samples) {
+                    double elevation, const py::object& displacement_reference, bool color_bar, int samples,
+                    int threads) {
   MeshArgs args = mesh_args(V, F);
   RenderOptions options;
   options.width = width;
@@ -549,11 +550,8 @@ py::array py_render(const py::handle& V, const py::handle& F, int width, int hei
   Mesh mesh;
   mesh.V = std::move(args.V);
   mesh.F = std::move(args.F);
-  Image image;
-  {
-    py::gil_scoped_release release;
-    image = render_mesh(mesh, options);
-  }
+  // threads limits the TBB part (arrays, colours); llvmpipe rasterises with LP_NUM_THREADS.
+  const Image image = without_gil(threads, [&] { return render_mesh(mesh, options); });
   py::array_t<std::uint8_t> rgb(
       {static_cast<py::ssize_t>(image.height), static_cast<py::ssize_t>(image.width), static_cast<py::ssize_t>(3)});
   std::uint8_t* out = rgb.mutable_data();
@@ -737,9 +735,11 @@ distances, edge-error CV, redistribution rho, |H| percentiles, quality, degenera
         py::arg("height") = 600, py::arg("view") = "iso", py::arg("color") = "none", py::arg("shading") = "smooth",
         py::arg("wireframe") = false, py::arg("azimuth") = 30.0, py::arg("elevation") = 20.0,
         py::arg("displacement_reference") = py::none(), py::arg("color_bar") = true, py::arg("samples") = 4,
+        py::arg("threads") = 0,
         R"doc(Renders the mesh off-screen (OSMesa) -> (height, width, 3) uint8 RGB array, rows top to bottom.
 view: front, side, top, iso, custom (azimuth, elevation); color: none, mean, gauss, quality,
-displacement (needs displacement_reference, the positions before); shading: smooth, flat.)doc");
+displacement (needs displacement_reference, the positions before); shading: smooth, flat.
+threads limits the TBB part; llvmpipe rasterises with LP_NUM_THREADS threads.)doc");
   m.def("enhance_file", &py_enhance_file, py::arg("input"), py::arg("output"),
         R"doc(enhance_file(input, output, *, force=False, metrics=True, threads=0, **flow options) -> dict
 
