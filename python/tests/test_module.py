@@ -260,3 +260,29 @@ def test_stub_lists_every_function_with_the_librarys_defaults():
         assert defaults[name] == library[name], name
     # Every keyword of the stub is accepted (a misspelt one raises TypeError).
     vertexflow.enhance(V, F, **{k: v for k, v in defaults.items() if k not in ("reference",)})
+
+
+# --- installation ------------------------------------------------------------------------------------
+
+
+def test_cmake_install_puts_the_module_in_the_site_directory(tmp_path):
+    import os
+    import subprocess
+    import sys
+
+    build = os.environ.get("VERTEXFLOW_BUILD_DIR")
+    if not build:
+        pytest.skip("VERTEXFLOW_BUILD_DIR not set (ctest sets it)")
+    prefix = tmp_path / "prefix"
+    subprocess.run(["cmake", "--install", build, "--component", "python", "--prefix", prefix], check=True,
+                   capture_output=True)
+    site = prefix / os.environ["VERTEXFLOW_PYTHON_INSTALL_DIR"]
+    assert (site / "vertexflow.pyi").is_file()
+    # Debian's python3 has PREFIX/lib/python3.X/dist-packages on sys.path for PREFIX=/usr/local.
+    if str(prefix) not in str(site):
+        pytest.fail(f"{site} is not under the prefix")
+    script = "import vertexflow, sys; V, F = vertexflow.read_mesh(sys.argv[1]); print(vertexflow.__file__)"
+    env = dict(os.environ, PYTHONPATH=str(site))
+    result = subprocess.run([sys.executable, "-c", script, DATA / "spot.obj"], check=True, capture_output=True,
+                            text=True, env=env, cwd=tmp_path)
+    assert result.stdout.strip().startswith(str(site))
