@@ -56,10 +56,14 @@ def main():
                  "--threads", "1", "--force", "--summary", pathlib.Path(tmp) / "dask.json", *extra], pathlib.Path(tmp) / "dask.json"),
         }
         print(f"20 meshes, metrics {'off' if extra else 'on'}, {os.cpu_count()} cores, load average before {os.getloadavg()[0]:.2f}; median of {args.repeats}")
-        for name, setting in settings.items():
-            runs = [setting() for _ in range(args.repeats)]
-            files = statistics.median(r[0] for r in runs)
-            wall = statistics.median(r[1] for r in runs)
+        # Round-robin over the settings, so that a change of the machine's load hits all alike.
+        runs = {name: [] for name in settings}
+        for _ in range(args.repeats):
+            for name, setting in settings.items():
+                runs[name].append(setting())
+        for name in settings:
+            files = statistics.median(r[0] for r in runs[name])
+            wall = statistics.median(r[1] for r in runs[name])
             print(f"{name:32s} {20 / files:6.2f} meshes/s over the files ({files:.2f} s), "
                   f"{20 / wall:6.2f} meshes/s whole command ({wall:.2f} s)")
         print(f"load average after {os.getloadavg()[0]:.2f}")
