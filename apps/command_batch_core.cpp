@@ -13,6 +13,7 @@
 #include <algorithm>
 #include <atomic>
 #include <exception>
+#include <fstream>
 #include <map>
 #include <mutex>
 #include <new>
@@ -93,6 +94,53 @@ std::string csv_field(const std::string& s) {
   std::string q = "\"";
   for (char c : s) q += c == '"' ? std::string("\"\"") : std::string(1, c == '\n' ? ' ' : c);
   return q + "\"";
+}
+
+// The rows of an earlier summary in the output directory, by input path: a file skipped now keeps
+// the measurements of the run that wrote its output. A missing or unreadable summary gives none.
+std::map<std::string, nlohmann::json> previous_rows(const std::filesystem::path& json_path) {
+  std::map<std::string, nlohmann::json> rows;
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(json_path, ec)) return rows;
+  try {
+    std::ifstream in(json_path);
+    const nlohmann::json summary = nlohmann::json::parse(in);
+    for (const auto& row : summary.at("files"))
+      if (row.at("status") == "done" || (row.at("status") == "skipped" && !row.at("vertices").is_null()))
+        rows[row.at("input").get<std::string>()] = row;
+  } catch (const std::exception&) {
+    rows.clear();  // not ours, or damaged: start afresh
+  }
+  return rows;
+}
+
+// `row` (skipped) with the measurements of `previous` (to_json's layout).
+void take_measurements(BatchRow& row, const nlohmann::json& previous) {
+  const auto number = [](const nlohmann::json& j) { return j.is_number() ? j.get<double>() : std::nan(""); };
+  const auto count = [](const nlohmann::json& j) { return j.is_number() ? j.get<long long>() : -1LL; };
+  try {
+    row.warnings = previous.at("warnings").get<std::string>();
+    row.vertices = count(previous.at("vertices"));
+    row.faces = count(previous.at("faces"));
+    const auto& seconds = previous.at("seconds");
+    row.seconds_read = number(seconds.at("read"));
+    row.seconds_enhance = number(seconds.at("enhance"));
+    row.seconds_write = number(seconds.at("write"));
+    row.seconds_metrics = number(seconds.at("metrics"));
+    row.seconds_total = number(seconds.at("total"));
+    row.flipped_faces = count(previous.at("flipped_faces"));
+    row.limited_vertices = count(previous.at("limited_vertices"));
+    row.rho_input = number(previous.at("redistribution_rho").at("input"));
+    row.rho_result = number(previous.at("redistribution_rho").at("result"));
+    row.cv_input = number(previous.at("edge_error_cv").at("input"));
+    row.cv_result = number(previous.at("edge_error_cv").at("result"));
+    row.displacement_mean = number(previous.at("displacement_edge_lengths").at("mean"));
+    row.displacement_max = number(previous.at("displacement_edge_lengths").at("max"));
+  } catch (const std::exception&) {
+    const BatchRow fresh;
+    row.vertices = fresh.vertices;  // an incomplete row: keep none of it
+    row.faces = fresh.faces;
+  }
 }
 
 std::string csv_number(double x) {
@@ -203,6 +251,9 @@ BatchSummary run_batch(const BatchOptions& options) {
     }
   }
 
+  const std::map<std::string, nlohmann::json> previous = options.write_summary
+                                                             ? previous_rows(options.output_dir / "batch_summary.json")
+                                                             : std::map<std::string, nlohmann::json>{};
   const auto start = Clock::now();
   std::atomic<std::size_t> next{0};
   std::mutex mutex;
@@ -211,7 +262,11 @@ BatchSummary run_batch(const BatchOptions& options) {
   auto worker = [&] {
     for (std::size_t i = next++; i < files.size(); i = next++) {
       if (!preset[i]) summary.rows[i] = enhance_file(files[i], outputs[i], file_options);
-      const BatchRow& row = summary.rows[i];
+      BatchRow& row = summary.rows[i];
+      if (row.status == "skipped") {
+        const auto it = previous.find(row.input);
+        if (it != previous.end()) take_measurements(row, it->second);
+      }
       const std::lock_guard lock(mutex);
       ++finished;
       if (row.status == "failed") ++failed;

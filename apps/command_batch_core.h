@@ -25,7 +25,10 @@ namespace vertexflow::cli {
 struct BatchRow {
   std::string input;
   std::string output;
-  std::string status;    ///< "done", "skipped" (output existed) or "failed"
+  /// "done", "skipped" (output existed) or "failed". A skipped file keeps the measurements and
+  /// seconds of the run that wrote its output, from the batch_summary.json found in the output
+  /// directory (none if there is none), so a resumed batch's summary still has every file.
+  std::string status;
   std::string error;     ///< the one-line error of a failed file ("FILE: problem")
   std::string warnings;  ///< reading and flow warnings, "; "-separated
   long long vertices = -1, faces = -1;

@@ -71,9 +71,17 @@ def test_batch_outputs_are_what_enhance_writes(cli_run, messy, tmp_path):
 def test_second_run_skips_everything_done(cli_run, messy):
     out, _ = cli_run
     before = {p.name: p.stat().st_mtime_ns for p in out.iterdir()}
+    first_rows, _ = read_summary(out)
     second = run_cli("batch", messy, out, "--jobs", "2", check=False)
     rows, summary = read_summary(out)
     assert summary["skipped"] == 20 and summary["done"] == 0 and summary["failed"] == 2
+    # The skipped files keep the first run's measurements: the table still describes every output.
+    for old, new in zip(first_rows, rows):
+        assert old["input"] == new["input"]
+        if old["status"] == "done":
+            assert new["status"] == "skipped"
+            for column in ("vertices", "flipped_faces", "rho_input", "rho_result", "cv_result", "displacement_max"):
+                assert new[column] == old[column] != "", column
     after = {p.name: p.stat().st_mtime_ns for p in out.iterdir()}
     assert all(after[n] == before[n] for n in before if not n.startswith("batch_summary"))
     assert second.returncode == 1
