@@ -71,6 +71,15 @@ def main(argv=None):
         if getattr(args, key) is not None:
             options[key] = getattr(args, key)
 
+    # As `vertexflow batch`: a file skipped now keeps the row of the run that wrote its output.
+    summary_path = args.summary or os.path.join(output_dir, "batch_summary.json")
+    previous = {}
+    try:
+        with open(summary_path) as f:
+            previous = {r["input"]: r for r in json.load(f)["files"] if r.get("vertices") is not None}
+    except (OSError, ValueError, KeyError, TypeError):
+        pass
+
     cluster = None
     if args.scheduler:
         client = Client(args.scheduler)
@@ -88,6 +97,8 @@ def main(argv=None):
         failed = 0
         for finished, future in enumerate(as_completed(futures), 1):
             row = future.result()
+            if row["status"] == "skipped" and row["input"] in previous:
+                row = dict(previous[row["input"]], status="skipped")
             rows[index[future.key]] = row
             failed += row["status"] == "failed"
             elapsed = time.monotonic() - start
@@ -110,7 +121,6 @@ def main(argv=None):
         "meshes_per_second": len(rows) / seconds if seconds > 0 else None,
         "files": rows,
     }
-    summary_path = args.summary or os.path.join(output_dir, "batch_summary.json")
     tmp = summary_path + ".tmp"
     with open(tmp, "w") as f:
         json.dump(summary, f, indent=2)
