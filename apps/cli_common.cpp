@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cstdio>
+#include <map>
 #include <system_error>
 
 namespace vertexflow::cli {
@@ -104,6 +105,59 @@ void warn_about_repairs(const std::string& input, const SurfaceRepairs& repairs,
                "vertexflow: warning: {}: the result had {} zero-area faces (removed) and {} vertices pinched between "
                "fans (duplicated)\n",
                input, repairs.removed_degenerate_faces, repairs.duplicated_vertices);
+}
+
+void add_flow_options(CLI::App* command, FlowOptions& flow, bool& no_projection) {
+  command
+      ->add_option("--lambda", flow.weights.lambda,
+                   "Weight of the distance to the input: smaller moves vertices further (0.2 strong .. 50 faint)")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  command->add_option("--mu", flow.weights.mu, "Weight of the fairness term")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  command->add_option("--iterations", flow.iterations, "Solves, curvature recomputed in between")
+      ->check(CLI::Range(1, 20))
+      ->capture_default_str();
+  command
+      ->add_option("--min-quality", flow.min_quality,
+                   "Guard: no face ends below min(this, the worst input radius ratio 2r/R around its corners); "
+                   "0 repairs only flips")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  command
+      ->add_option("--sliver-floor", flow.sliver_floor,
+                   "Guard: a face starting below --min-quality may not fall below this fraction of its input ratio")
+      ->check(CLI::Range(0.0, 1.0))
+      ->capture_default_str();
+  command
+      ->add_option("--sliver-stiffness", flow.weights.sliver,
+                   "Weight of the solve's term that keeps corners of faces below --min-quality from their opposite "
+                   "edges (0: the guard alone)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  command->add_flag("--no-projection", no_projection,
+                    "Leave vertices where the solve puts them instead of moving them onto the input surface");
+  command
+      ->add_option("--fairness", flow.weights.fairness_target,
+                   "Target of the fairness term: input-normal (default; keeps the shape) or zero (the paper's)")
+      ->transform(
+          CLI::CheckedTransformer(std::map<std::string, FairnessTarget>{{"input-normal", FairnessTarget::InputNormal},
+                                                                        {"zero", FairnessTarget::Zero}},
+                                  CLI::ignore_case));
+  command
+      ->add_option("--feature-angle", flow.feature_angle,
+                   "Dihedral angle (degrees) above which an edge is a crease vertices slide along, not across")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  command
+      ->add_option("--solver", flow.solver,
+                   "Linear solver: automatic (default; flow.h says how it chooses), direct, iterative or multilevel")
+      ->transform(CLI::CheckedTransformer(std::map<std::string, LinearSolver>{{"automatic", LinearSolver::Automatic},
+                                                                              {"direct", LinearSolver::Direct},
+                                                                              {"iterative", LinearSolver::Iterative},
+                                                                              {"multilevel", LinearSolver::Multilevel}},
+                                          CLI::ignore_case));
 }
 
 nlohmann::json to_json(const MeshInfo& info) {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "vertexflow/distance.h"
+#include "vertexflow/flow.h"
 #include "vertexflow/io.h"
 #include "vertexflow/manifold_split.h"
 #include "vertexflow/mesh_info.h"
@@ -60,6 +61,12 @@ nlohmann::json to_json(const ReadReport& report);
 /// mean, rms, max (absolute), the same divided by `length_scale` (*_relative), and points.
 nlohmann::json to_json(const DistanceStats& stats, double length_scale);
 
+/// Registers the options of the flow that `enhance` and `batch` share: --lambda, --mu,
+/// --iterations, --min-quality, --sliver-floor, --sliver-stiffness, --no-projection (into
+/// `no_projection`; the caller sets flow.project_to_input from it), --fairness, --feature-angle
+/// and --solver.
+void add_flow_options(CLI::App* command, FlowOptions& flow, bool& no_projection);
+
 /// Registers the subcommands (one function per command file).
 void register_info_command(CLI::App& app, const GlobalOptions& global);
 void register_curvature_command(CLI::App& app, const GlobalOptions& global);
@@ -69,5 +76,6 @@ void register_remesh_command(CLI::App& app, const GlobalOptions& global);
 void register_render_command(CLI::App& app, const GlobalOptions& global);
 void register_report_command(CLI::App& app, const GlobalOptions& global);
 void register_compare_command(CLI::App& app, const GlobalOptions& global);
+void register_batch_command(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace vertexflow::cli

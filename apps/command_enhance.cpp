@@ -302,56 +302,7 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
   CLI::App* command = app.add_subcommand("enhance", "Enhance shape features by vertex flow (Ji et al. 2011)");
   command->add_option("IN", o->input, "Input mesh")->required();
   command->add_option("OUT", o->output, "Output mesh (same connectivity)")->required();
-  command
-      ->add_option("--lambda", o->flow.weights.lambda,
-                   "Weight of the distance to the input: smaller moves vertices further (0.2 strong .. 50 faint)")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
-  command->add_option("--mu", o->flow.weights.mu, "Weight of the fairness term")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  command->add_option("--iterations", o->flow.iterations, "Solves, curvature recomputed in between")
-      ->check(CLI::Range(1, 20))
-      ->capture_default_str();
-  command
-      ->add_option("--min-quality", o->flow.min_quality,
-                   "Guard: no face ends below min(this, the worst input radius ratio 2r/R around its corners); "
-                   "0 repairs only flips")
-      ->check(CLI::Range(0.0, 1.0))
-      ->capture_default_str();
-  command
-      ->add_option("--sliver-floor", o->flow.sliver_floor,
-                   "Guard: a face starting below --min-quality may not fall below this fraction of its input ratio")
-      ->check(CLI::Range(0.0, 1.0))
-      ->capture_default_str();
-  command
-      ->add_option("--sliver-stiffness", o->flow.weights.sliver,
-                   "Weight of the solve's term that keeps corners of faces below --min-quality from their opposite "
-                   "edges (0: the guard alone)")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  command->add_flag("--no-projection", o->no_projection,
-                    "Leave vertices where the solve puts them instead of moving them onto the input surface");
-  command
-      ->add_option("--fairness", o->flow.weights.fairness_target,
-                   "Target of the fairness term: input-normal (default; keeps the shape) or zero (the paper's)")
-      ->transform(
-          CLI::CheckedTransformer(std::map<std::string, FairnessTarget>{{"input-normal", FairnessTarget::InputNormal},
-                                                                        {"zero", FairnessTarget::Zero}},
-                                  CLI::ignore_case));
-  command
-      ->add_option("--feature-angle", o->flow.feature_angle,
-                   "Dihedral angle (degrees) above which an edge is a crease vertices slide along, not across")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  command
-      ->add_option("--solver", o->flow.solver,
-                   "Linear solver: automatic (default; flow.h says how it chooses), direct, iterative or multilevel")
-      ->transform(CLI::CheckedTransformer(std::map<std::string, LinearSolver>{{"automatic", LinearSolver::Automatic},
-                                                                              {"direct", LinearSolver::Direct},
-                                                                              {"iterative", LinearSolver::Iterative},
-                                                                              {"multilevel", LinearSolver::Multilevel}},
-                                          CLI::ignore_case));
+  add_flow_options(command, o->flow, o->no_projection);
   command->add_option("--method", o->method, "flow (Ji et al.) or unsharp (geometric unsharp mask baseline)")
       ->check(CLI::IsMember({"flow", "unsharp"}))
       ->capture_default_str();

@@ -36,6 +36,7 @@ int main(int argc, char** argv) {
   register_render_command(app, global);
   register_report_command(app, global);
   register_compare_command(app, global);
+  register_batch_command(app, global);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

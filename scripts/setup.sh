@@ -25,6 +25,9 @@ packages=(
   clang libclang-rt-14-dev # libFuzzer targets and sanitizers
   clang-format
   python3                  # bench/make_results.py (docs/results.md)
+  python3-dev pybind11-dev python3-pybind11  # the Python module (python/)
+  python3-numpy python3-pytest               # its API and test suite
+  python3-dask python3-distributed           # examples/dask_batch.py and its test
   chromium chromium-driver # headless browser test of the HTML report (tests/CMakeLists.txt)
 )
 
