@@ -48,7 +48,8 @@ struct FitOptions {
   double samples_per_vertex = 10;
   /// w_v: the weight of the mesh -> reference direction relative to the reference -> mesh one.
   double mesh_to_reference_weight = 1.0;
-  /// w_f: the weight of the anchored Laplacian (see above).
+  /// w_f: the weight of the anchored Laplacian (see above). 0 leaves it out (smooth mode, where
+  /// every face has data); reference mode keeps it for the faces no sample of S falls on.
   double fairness = 0.05;
   /// w_p: the weight of the proximity term (see above).
   double proximity = 0.01;
@@ -144,10 +145,15 @@ struct SmoothFitOptions {
   /// 1 fits every input.
   double max_poor_face_fraction = 0.03;
   /// The fit's weights and guard; one round (above). samples_per_vertex, mesh_to_reference_weight
-  /// and seed are not used: the data are the patches' points.
+  /// and seed are not used: the data are the patches' points. No fairness: every face has data,
+  /// so the proximity term alone keeps the solve definite, and the system keeps the faces'
+  /// pattern, whose factor fills in far less than the anchored Laplacian's (measured on the 6k
+  /// remeshes and bunny_uniform: mean distance within 0.3 points of fairness 0.05, in 40-60% of
+  /// the time).
   FitOptions fit = [] {
     FitOptions o;
     o.max_rounds = 1;
+    o.fairness = 0;
     return o;
   }();
 };
@@ -159,7 +165,7 @@ FitResult fit_to_smooth_surface(const Vertices& V, const Faces& F, const SmoothF
 /// Moves the vertices of (V, F) to minimise the two-sided distance to the reference surface
 /// (VR, FR), as described above. Throws std::invalid_argument for an empty mesh or reference,
 /// a non-finite coordinate, options out of range (samples_per_vertex > 0, weights >= 0 and
-/// finite, fairness > 0, max_rounds >= 1, tolerance >= 0, min_quality and sliver_floor in
+/// finite, max_rounds >= 1, tolerance >= 0, min_quality and sliver_floor in
 /// [0, 1], pinned indices in range).
 FitResult fit_to_reference(const Vertices& V, const Faces& F, const Vertices& VR, const Faces& FR,
                            const FitOptions& options = {});

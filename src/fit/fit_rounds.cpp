@@ -50,7 +50,7 @@ void validate_fit(const Vertices& V, const Faces& F, const FitOptions& o, const 
   require(std::isfinite(o.samples_per_vertex) && o.samples_per_vertex > 0, "samples_per_vertex must be > 0");
   require(std::isfinite(o.mesh_to_reference_weight) && o.mesh_to_reference_weight >= 0,
           "mesh_to_reference_weight must be a finite number >= 0");
-  require(std::isfinite(o.fairness) && o.fairness > 0, "fairness must be a finite number > 0");
+  require(std::isfinite(o.fairness) && o.fairness >= 0, "fairness must be a finite number >= 0");
   require(std::isfinite(o.proximity) && o.proximity > 0, "proximity must be a finite number > 0");
   require(o.max_rounds >= 1, "max_rounds must be at least 1");
   require(std::isfinite(o.tolerance) && o.tolerance >= 0, "tolerance must be a finite number >= 0");
@@ -221,7 +221,9 @@ FitRounds::FitRounds(const Vertices& V, const Faces& F, Topology topology, const
                 topology_.face_offsets[v] == topology_.face_offsets[v + 1];
   }
   for (const Index p : options.pinned) fixed_[static_cast<std::size_t>(p)] = 1;
-  const SparseMatrix L = uniform_laplacian(topology_, n);
+  // Without fairness the pattern is the faces' alone, whose factor fills in far less than with
+  // the anchored Laplacian's two-rings.
+  const SparseMatrix L = options.fairness > 0 ? uniform_laplacian(topology_, n) : SparseMatrix(n, n);
   system_ = std::make_unique<FitSystem>(F, SparseMatrix(SparseMatrix(L.transpose()) * L), fixed_);
   criteria_ = std::make_unique<GuardCriteria>(guard_criteria(V, F, options.min_quality, options.sliver_floor));
   no_features_ = detect_features(V, F, topology_, 180.0);

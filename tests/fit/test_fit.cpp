@@ -154,7 +154,7 @@ TEST(FitToReference, RefusesBadInputAndOptions) {
   EXPECT_THROW(fit_to_reference(sphere.V, sphere.F, Vertices(0, 3), Faces(0, 3)), std::invalid_argument);
   EXPECT_THROW(fit_to_reference(Vertices(0, 3), Faces(0, 3), sphere.V, sphere.F), std::invalid_argument);
   for (auto set : std::vector<void (*)(FitOptions&)>{
-           [](FitOptions& o) { o.samples_per_vertex = 0; }, [](FitOptions& o) { o.fairness = 0; },
+           [](FitOptions& o) { o.samples_per_vertex = 0; }, [](FitOptions& o) { o.fairness = -1; },
            [](FitOptions& o) { o.mesh_to_reference_weight = -1; }, [](FitOptions& o) { o.max_rounds = 0; },
            [](FitOptions& o) { o.tolerance = -1; }, [](FitOptions& o) { o.min_quality = 2; },
            [](FitOptions& o) { o.pinned = {1000}; }}) {

@@ -86,7 +86,7 @@ TEST(SmoothFit, InscribedSphereMovesTowardsTheSphere) {
 }
 
 // Issue 16's bar for smooth mode on bunny_uniform: the mean distance to the dense bunny at least
-// 10% below the input's. Measured -26.6%, 1 round.
+// 10% below the input's. Measured -26.8%, 1 round.
 TEST(SmoothFit, BunnyUniformComesCloserToTheDenseBunny) {
   const Mesh coarse = read_mesh(test::data_path("bunny_uniform.off"));
   const Mesh dense = read_mesh(test::data_path("bunny.off"));
@@ -118,7 +118,7 @@ TEST(SmoothFit, DecimatedInputIsHeldAndWouldOvershoot) {
   EXPECT_FALSE(fitted.report.held_as_decimated);
   const double in = mean_two_sided(coarse.V, coarse.F, dense), out = mean_two_sided(fitted.V, coarse.F, dense);
   std::cout << "[measured] smooth on QEM bunny, not held: mean " << out / in - 1 << "\n";
-  EXPECT_GT(out, 1.2 * in);  // measured +70%
+  EXPECT_GT(out, 1.2 * in);  // measured +73%
   anyway.max_poor_face_fraction = 1.5;
   EXPECT_THROW(fit_to_smooth_surface(coarse.V, coarse.F, anyway), std::invalid_argument);
 }
