@@ -59,7 +59,9 @@ def enhance(
     normal_weighting: Literal["max1999", "area", "angle"] = "max1999",
     solver: Literal["automatic", "direct", "iterative", "multilevel"] = "automatic",
     solver_tolerance: float = 1e-7,
-    max_rounds: int = 10,
+    max_rounds: int | None = None,
+    reference_method: Literal["fit", "flow"] = "fit",
+    assume_on_surface: bool = False,
     threads: int = 0,
     progress: Callable[[str], Any] | None = None,
 ) -> tuple[npt.NDArray[np.float64], dict[str, Any]]: ...

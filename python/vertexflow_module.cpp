@@ -370,19 +370,29 @@ py::tuple py_enhance(const py::handle& V, const py::handle& F, const py::kwargs&
   py::dict rest = take_flow_options(kwargs, flow);
   const auto surface = pop_option<std::string>(rest, "surface", "input");
   const py::object reference = pop_option<py::object>(rest, "reference", py::none());
-  const int max_rounds = pop_option<int>(rest, "max_rounds", FitOptions{}.max_rounds);
+  const py::object max_rounds = pop_option<py::object>(rest, "max_rounds", py::none());
+  const bool assume_on_surface = pop_option<bool>(rest, "assume_on_surface", false);
+  const auto reference_method = pop_option<std::string>(rest, "reference_method", "fit");
   const int threads = pop_option<int>(rest, "threads", 0);
   const py::object progress = pop_option<py::object>(rest, "progress", py::none());
   if (rest.size() > 0) unknown_keyword("enhance", rest);
   if (surface != "input" && surface != "smooth")
     throw py::value_error("option surface: '" + surface + "' is not one of input, smooth");
-  const bool fit = !reference.is_none();
-  if (fit && surface == "smooth") throw py::value_error("reference and surface='smooth' exclude each other");
+  if (reference_method != "fit" && reference_method != "flow")
+    throw py::value_error("option reference_method: '" + reference_method + "' is not one of fit, flow");
+  const bool on_reference = !reference.is_none();
+  const bool reference_flow = on_reference && reference_method == "flow";
+  const bool fit = on_reference && !reference_flow;
+  if (on_reference && surface == "smooth") throw py::value_error("reference and surface='smooth' exclude each other");
+  if (reference_flow && !max_rounds.is_none())
+    throw py::value_error("max_rounds does not apply to reference_method='flow'");
+  if (assume_on_surface && surface != "smooth")
+    throw py::value_error("assume_on_surface applies to surface='smooth' only");
 
   const MeshArgs args = mesh_args(V, F);
   validate_flow_options(flow, static_cast<Index>(args.V.rows()));
   MeshArgs ref;
-  if (fit) {
+  if (on_reference) {
     if (!py::isinstance<py::tuple>(reference) && !py::isinstance<py::list>(reference))
       throw py::value_error("reference must be a pair (V, F) of the dense mesh");
     const py::sequence pair = reference.cast<py::sequence>();
@@ -395,16 +405,22 @@ py::tuple py_enhance(const py::handle& V, const py::handle& F, const py::kwargs&
   fit_options.pinned = flow.pinned;
   fit_options.min_quality = flow.min_quality;
   fit_options.sliver_floor = flow.sliver_floor;
-  fit_options.max_rounds = max_rounds;
   SmoothFitOptions smooth;
   smooth.surface.feature_angle = flow.feature_angle;
   smooth.fit.fix_boundary = fit_options.fix_boundary;
   smooth.fit.pinned = fit_options.pinned;
   smooth.fit.min_quality = fit_options.min_quality;
   smooth.fit.sliver_floor = fit_options.sliver_floor;
-  smooth.fit.max_rounds = max_rounds;
+  if (!max_rounds.is_none()) {  // otherwise each mode's own default (10 for the fit, 1 for smooth)
+    fit_options.max_rounds = cast_option<int>("max_rounds", max_rounds);
+    smooth.fit.max_rounds = fit_options.max_rounds;
+  }
+  if (assume_on_surface) smooth.max_poor_face_fraction = 1.0;
 
-  const std::string method = fit ? "reference" : surface == "smooth" ? "smooth" : "flow";
+  const std::string method = fit                   ? "reference"
+                             : reference_flow      ? "reference-flow"
+                             : surface == "smooth" ? "smooth"
+                                                   : "flow";
   report_progress(progress, "enhance: " + method + " on " + std::to_string(args.V.rows()) + " vertices");
   Vertices out;
   nlohmann::json report;
@@ -419,9 +435,13 @@ py::tuple py_enhance(const py::handle& V, const py::handle& F, const py::kwargs&
       report = r.report;
       report["options"] = smooth.fit;
       report["options"]["surface"] = smooth.surface;
+      report["options"]["max_poor_face_fraction"] = smooth.max_poor_face_fraction;
+      report["fit"]["poor_face_fraction"] = r.report.poor_face_fraction;
+      report["fit"]["held_as_decimated"] = r.report.held_as_decimated;
       out = std::move(r.V);
     } else {
-      FlowResult r = vertex_flow(args.V, args.F, flow);
+      FlowResult r = reference_flow ? vertex_flow_on_reference(args.V, args.F, ref.V, ref.F, flow)
+                                    : vertex_flow(args.V, args.F, flow);
       report = r.report;
       report["options"] = flow;
       report["held_non_manifold_vertices"] = r.report.held_non_manifold_vertices;
@@ -710,12 +730,15 @@ k1 >= k2 (n,) arrays, T1, T2, N unit (n, 3) arrays. Convex with outward normals 
         epsilon=1e-6, sliver=0.02, fairness_target="input-normal", d_percentile=99.0,
         project_to_input=True, feature_angle=40.0, fix_boundary=True, refuse_non_manifold=False,
         max_halvings=30, min_quality=0.3, sliver_floor=0.5, curvature_smoothing_rounds=0,
-        normal_weighting="max1999", solver="automatic", solver_tolerance=1e-7, max_rounds=10,
-        threads=0, progress=None) -> (V_out, report)
+        normal_weighting="max1999", solver="automatic", solver_tolerance=1e-7, max_rounds=None,
+        reference_method="fit", assume_on_surface=False, threads=0, progress=None) -> (V_out, report)
 
 Moves the vertices of (V, F) by vertex flow (same connectivity); every FlowOptions field is a
 keyword (flow.h documents them). surface="smooth" or reference=(V_ref, F_ref) fit the vertices
-instead, as `vertexflow enhance --surface smooth` / `--reference` do (max_rounds applies to them).
+instead, as `vertexflow enhance --surface smooth` / `--reference` do (max_rounds applies to them;
+None keeps each mode's default: 10 rounds for the reference, 1 for smooth). reference_method="flow"
+runs the paper's flow on the reference (`--reference-method flow`); assume_on_surface=True fits
+smooth mode's input even when it looks decimated (`--assume-on-surface`).
 V_out is bit for bit what `vertexflow enhance` writes for the same options. report is the dict of
 the enhance report's method sections (options, solver, guard, seconds). progress(str) is called
 before and after.)doc");

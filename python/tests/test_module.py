@@ -65,6 +65,24 @@ def test_enhance_smooth_and_reference_modes():
     Vr, rr = vertexflow.enhance(V, F, reference=(VR, FR), max_rounds=1)
     assert rr["method"] == "reference" and rr["fit"]["rounds"] == 1
     assert rr["fit"]["rms_distance"][1] < rr["fit"]["rms_distance"][0]
+    # The paper's flow on the reference; max_rounds does not apply to it.
+    Vf, rf = vertexflow.enhance(V, F, reference=(VR, FR), reference_method="flow")
+    assert rf["method"] == "reference-flow" and not np.array_equal(Vf, V)
+    with pytest.raises(ValueError, match="max_rounds"):
+        vertexflow.enhance(V, F, reference=(VR, FR), reference_method="flow", max_rounds=2)
+    # Smooth mode's own default is one round.
+    assert vertexflow.enhance(V, F, surface="smooth")[1]["fit"]["rounds"] == 1
+
+
+def test_smooth_mode_holds_decimated_input_unless_told():
+    V, F = read("bunny.off")
+    Vq, Fq = vertexflow.simplify(V, F, faces=6000)  # QEM: 5.6% of the faces below quality 0.3
+    held, report = vertexflow.enhance(Vq, Fq, surface="smooth")
+    assert report["fit"]["held_as_decimated"] and np.array_equal(held, Vq)
+    fitted, report = vertexflow.enhance(Vq, Fq, surface="smooth", assume_on_surface=True)
+    assert not report["fit"]["held_as_decimated"] and not np.array_equal(fitted, Vq)
+    with pytest.raises(ValueError, match="assume_on_surface"):
+        vertexflow.enhance(Vq, Fq, assume_on_surface=True)
 
 
 def test_thread_count_does_not_change_the_result():
