@@ -45,6 +45,7 @@ struct Candidate {
   Index f1 = -1, f2 = -1;  // f1 holds the edge as a -> b
   Index a = 0, b = 0, c = 0, d = 0;
   double gain = 0;
+  double error1 = 0, error2 = 0;  // E of the new faces (a, d, c) and (d, b, c)
 };
 
 }  // namespace
@@ -66,12 +67,14 @@ EdgeFlipResult flip_edges_toward(const Vertices& V, const Faces& F, const Distan
   EdgeFlipReport& report = result.report;
   double area = 0;
   for (Index f = 0; f < m; ++f) area += 0.5 * normal_of(corners(V, G(f, 0), G(f, 1), G(f, 2))).norm();
+  // E of every face, computed once: a flip replaces its two faces' E by the values its
+  // evaluation computed for the new faces (the same corners in the same order).
   Eigen::VectorXd error(m);
+  parallel_for_index(m, [&](Index f) { error[f] = face_error(corners(V, G(f, 0), G(f, 1), G(f, 2)), target); });
   auto rms = [&] { return area > 0 ? std::sqrt(error.sum() / area) : 0.0; };
+  report.rms_before = rms();
 
   for (int pass = 0; pass < options.max_passes; ++pass) {
-    parallel_for_index(m, [&](Index f) { error[f] = face_error(corners(V, G(f, 0), G(f, 1), G(f, 2)), target); });
-    if (pass == 0) report.rms_before = rms();
     // Half-edges (a -> b of face f, corner k) sorted by undirected edge: an interior manifold
     // edge is a run of exactly two, one each way.
     struct HalfEdge {
@@ -141,7 +144,9 @@ EdgeFlipResult flip_edges_toward(const Vertices& V, const Faces& F, const Distan
           std::max({(old1[1] - old1[0]).norm(), (old1[2] - old1[1]).norm(), (old1[0] - old1[2]).norm(),
                     (old2[2] - old2[0]).norm(), (old2[2] - old2[1]).norm()});
       const double noise = 0.5 * (n1.norm() + n2.norm()) * 1e-12 * length * length;
-      const double after = face_error(new1, target) + face_error(new2, target);
+      c.error1 = face_error(new1, target);
+      c.error2 = face_error(new2, target);
+      const double after = c.error1 + c.error2;
       if (before > noise && before - after > options.min_gain * before) c.gain = before - after;
     });
     std::erase_if(candidates, [](const Candidate& c) { return !(c.gain > 0); });
@@ -150,16 +155,18 @@ EdgeFlipResult flip_edges_toward(const Vertices& V, const Faces& F, const Distan
     std::vector<char> touched(static_cast<std::size_t>(m), 0);
     std::unordered_set<std::int64_t> made;
     Index flipped = 0;
+    // An interior vertex keeps at least three faces, a boundary one at least one.
+    auto keeps_enough = [&](Index v) {
+      return faces_at[static_cast<std::size_t>(v)] > (on_boundary[static_cast<std::size_t>(v)] ? 1 : 3);
+    };
     for (const Candidate& c : candidates) {
       if (touched[static_cast<std::size_t>(c.f1)] || touched[static_cast<std::size_t>(c.f2)]) continue;
-      // An interior vertex keeps at least three faces, a boundary one at least one.
-      auto keeps_enough = [&](Index v) {
-        return faces_at[static_cast<std::size_t>(v)] > (on_boundary[static_cast<std::size_t>(v)] ? 1 : 3);
-      };
       if (!keeps_enough(c.a) || !keeps_enough(c.b)) continue;
       if (!made.insert(edge_key(c.c, c.d, n)).second) continue;
       G.row(c.f1) << c.a, c.d, c.c;
       G.row(c.f2) << c.d, c.b, c.c;
+      error[c.f1] = c.error1;
+      error[c.f2] = c.error2;
       touched[static_cast<std::size_t>(c.f1)] = touched[static_cast<std::size_t>(c.f2)] = 1;
       --faces_at[static_cast<std::size_t>(c.a)];
       --faces_at[static_cast<std::size_t>(c.b)];
@@ -171,7 +178,6 @@ EdgeFlipResult flip_edges_toward(const Vertices& V, const Faces& F, const Distan
     report.passes = pass + 1;
     if (flipped == 0) break;
   }
-  parallel_for_index(m, [&](Index f) { error[f] = face_error(corners(V, G(f, 0), G(f, 1), G(f, 2)), target); });
   report.rms_after = rms();
   return result;
 }
