@@ -20,6 +20,7 @@ packages=(
   libosmesa6-dev           # off-screen software OpenGL (llvmpipe) for `vertexflow render`
   libpng-dev               # PNG output of renders
   libfreetype-dev fonts-dejavu-core  # colour-bar labels in renders
+  libcairo2-dev            # anti-aliased strokes of line drawings (`vertexflow lines`)
   libgtest-dev libgmock-dev
   libbenchmark-dev
   clang libclang-rt-14-dev # libFuzzer targets and sanitizers

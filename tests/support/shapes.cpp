@@ -138,13 +138,17 @@ Mesh cylinder(double radius, double height, int around, int along) {
 }
 
 Mesh torus(double R, double r, int around, int tube) {
+  return elliptic_torus(R, r, r, around, tube);
+}
+
+Mesh elliptic_torus(double R, double a, double b, int around, int tube) {
   std::vector<Eigen::Vector3d> p;
   for (int i = 0; i < around; ++i) {
     const double phi = 2 * M_PI * i / around;
     for (int j = 0; j < tube; ++j) {
       const double theta = 2 * M_PI * j / tube;
-      const double rho = R + r * std::cos(theta);
-      p.emplace_back(rho * std::cos(phi), rho * std::sin(phi), r * std::sin(theta));
+      const double rho = R + a * std::cos(theta);
+      p.emplace_back(rho * std::cos(phi), rho * std::sin(phi), b * std::sin(theta));
     }
   }
   std::vector<Eigen::Vector3i> f;
@@ -153,28 +157,55 @@ Mesh torus(double R, double r, int around, int tube) {
   return from_lists(p, f);
 }
 
-Mesh roof(int n, bool across) {
-  Mesh mesh;
-  mesh.V.resize((n + 1) * (n + 1), 3);
-  auto at = [n](int i, int j) { return static_cast<Index>(j * (n + 1) + i); };
-  for (int j = 0; j <= n; ++j)
-    for (int i = 0; i <= n; ++i) {
-      const double x = static_cast<double>(i) / n, y = static_cast<double>(j) / n;
-      mesh.V.row(at(i, j)) << x, y, -std::abs(x - y) / 2;
+Mesh height_field(double half, int n, const std::function<double(double, double)>& height) {
+  std::vector<Eigen::Vector3d> p;
+  for (int i = 0; i <= n; ++i) {
+    for (int j = 0; j <= n; ++j) {
+      const double x = -half + 2 * half * i / n, y = -half + 2 * half * j / n;
+      p.emplace_back(x, y, height(x, y));
     }
-  mesh.F.resize(2 * n * n, 3);
-  Index f = 0;
-  for (int j = 0; j < n; ++j)
-    for (int i = 0; i < n; ++i) {
-      if (across) {
-        mesh.F.row(f++) << at(i, j), at(i + 1, j), at(i, j + 1);
-        mesh.F.row(f++) << at(i + 1, j), at(i + 1, j + 1), at(i, j + 1);
-      } else {
-        mesh.F.row(f++) << at(i, j), at(i + 1, j), at(i + 1, j + 1);
-        mesh.F.row(f++) << at(i, j), at(i + 1, j + 1), at(i, j + 1);
+  }
+  std::vector<Eigen::Vector3i> f;
+  grid_triangles(
+      n, n, [&](int i, int j) { return i * (n + 1) + j; }, f);
+  return from_lists(p, f);
+}
+
+Mesh rounded_cube(double core, double radius, int n) {
+  // Lattice points (i, j, k) in [0, n]^3 on the cube's surface, welded by their integer key.
+  std::map<std::array<int, 3>, int> index;
+  std::vector<Eigen::Vector3d> p;
+  const auto vertex = [&](std::array<int, 3> key) {
+    const auto [it, added] = index.emplace(key, static_cast<int>(p.size()));
+    if (added) {
+      const Eigen::Vector3d x =
+          (core + radius) * (Eigen::Vector3d(key[0], key[1], key[2]) * 2.0 / n - Eigen::Vector3d::Ones());
+      const Eigen::Vector3d inner = x.cwiseMax(-core).cwiseMin(core);
+      p.push_back(inner + radius * (x - inner).normalized());
+    }
+    return it->second;
+  };
+  std::vector<Eigen::Vector3i> f;
+  for (int d = 0; d < 3; ++d) {
+    const int u = (d + 1) % 3, v = (d + 2) % 3;  // e_u x e_v = e_d
+    for (const int side : {0, n}) {
+      for (int i = 0; i < n; ++i) {
+        for (int j = 0; j < n; ++j) {
+          std::array<int, 4> q;
+          const int corner[4][2] = {{i, j}, {i + 1, j}, {i + 1, j + 1}, {i, j + 1}};
+          for (int c = 0; c < 4; ++c) {
+            std::array<int, 3> key{};
+            key[d] = side, key[u] = corner[c][0], key[v] = corner[c][1];
+            q[c] = vertex(key);
+          }
+          if (side == 0) std::swap(q[1], q[3]);  // the -e_d face looks the other way
+          f.emplace_back(q[0], q[1], q[2]);
+          f.emplace_back(q[0], q[2], q[3]);
+        }
       }
     }
-  return mesh;
+  }
+  return from_lists(p, f);
 }
 
 Mesh saddle(double half, int n) {

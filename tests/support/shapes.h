@@ -4,6 +4,8 @@
 
 #include "vertexflow/mesh.h"
 
+#include <functional>
+
 namespace vertexflow::test {
 
 /// Icosahedron subdivided `levels` times (each triangle into 4), projected onto the sphere of
@@ -18,6 +20,19 @@ Mesh cylinder(double radius, double height, int around, int along);
 /// big circle, `tube` around the tube; vertex (i, j) is at angles (2 pi i / around,
 /// 2 pi j / tube) with theta = 0 on the outer equator; outward orientation.
 Mesh torus(double R, double r, int around, int tube);
+
+/// The torus with an elliptic tube: semi-axis `a` in the radial direction, `b` along z; vertex
+/// (i, j) at (R + a cos theta) (cos phi, sin phi) + b sin theta z. With a > b the meridian
+/// curvature a / b^2 at both equators is the maximum over the tube; outward orientation.
+Mesh elliptic_torus(double R, double a, double b, int around, int tube);
+
+/// The graph z = height(x, y) over [-half, half]^2, n x n quads; normals up (+z).
+Mesh height_field(double half, int n, const std::function<double(double, double)>& height);
+
+/// A cube with rounded edges and corners: the points within `radius` of the cube [-core, core]^3
+/// (flat faces at +-(core + radius), quarter-cylinders along the edges, eighth-spheres at the
+/// corners), from an n x n grid per face; closed, outward orientation.
+Mesh rounded_cube(double core, double radius, int n);
 
 /// The saddle z = (x^2 - y^2) / 2 over [-half, half]^2, n x n quads; normals up (+z).
 Mesh saddle(double half, int n);

@@ -1,0 +1,54 @@
+// feature_lines (lines.h): every requested line type of one view.
+#include "lines/zero_set.h"
+#include "vertexflow/topology.h"
+
+#include <stdexcept>
+
+namespace vertexflow {
+
+std::string_view line_type_name(LineType type) {
+  switch (type) {
+    case LineType::Contour:
+      return "contours";
+    case LineType::SuggestiveContour:
+      return "suggestive-contours";
+    case LineType::Ridge:
+      return "ridges";
+    case LineType::Valley:
+      return "valleys";
+  }
+  return "unknown";
+}
+
+std::vector<Polyline> feature_lines(const Vertices& V, const Faces& F, const View& view, const LineOptions& options) {
+  lines_detail::check_line_input(V, F, {}, "feature lines");
+  if (!(options.length_scale >= 0) || !(options.suggestive_threshold >= 0) || !(options.ridge_threshold >= 0))
+    throw std::invalid_argument("feature lines: thresholds and the length scale must be >= 0");
+  std::vector<Polyline> lines;
+  if (F.rows() == 0) return lines;
+  const bool curved = options.suggestive_contours || options.ridges || options.valleys;
+  std::optional<Curvature> curvature;
+  CurvatureDerivative derivative;
+  if (curved) {
+    const Topology topology = build_topology(F, V.rows());
+    curvature = principal_curvatures(V, F, topology, options.curvature);
+    derivative = curvature_derivative(V, F, topology, *curvature);
+  }
+  const auto append = [&](std::vector<Polyline> more) {
+    lines.insert(lines.end(), std::make_move_iterator(more.begin()), std::make_move_iterator(more.end()));
+  };
+  if (options.contours)
+    append(occluding_contours(V, F, curvature ? curvature->N : vertex_normals(V, F, options.curvature.normal_weighting),
+                              view));
+  double L = options.length_scale;
+  if (L == 0) L = bounding_box(V).diagonal();
+  if (!(L > 0)) L = 1;  // every vertex in one point: nothing is curved
+  if (options.suggestive_contours)
+    append(suggestive_contours(V, F, *curvature, derivative, view, options.suggestive_threshold / (L * L)));
+  if (options.ridges || options.valleys)
+    append(
+        ridges_and_valleys(V, F, *curvature, derivative, options.ridge_threshold / L, options.ridges, options.valleys));
+  return lines;
+}
+
+}  // namespace vertexflow
