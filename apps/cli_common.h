@@ -74,6 +74,8 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global);
 void register_simplify_command(CLI::App& app, const GlobalOptions& global);
 void register_remesh_command(CLI::App& app, const GlobalOptions& global);
 void register_render_command(CLI::App& app, const GlobalOptions& global);
+void register_lines_command(CLI::App& app, const GlobalOptions& global);
+void register_compare_lines_command(CLI::App& app, const GlobalOptions& global);
 void register_report_command(CLI::App& app, const GlobalOptions& global);
 void register_compare_command(CLI::App& app, const GlobalOptions& global);
 void register_batch_command(CLI::App& app, const GlobalOptions& global);

@@ -34,6 +34,8 @@ int main(int argc, char** argv) {
   register_simplify_command(app, global);
   register_remesh_command(app, global);
   register_render_command(app, global);
+  register_lines_command(app, global);
+  register_compare_lines_command(app, global);
   register_report_command(app, global);
   register_compare_command(app, global);
   register_batch_command(app, global);

@@ -116,6 +116,44 @@ struct RenderOptions {
   int samples = 4;
 };
 
+/// The orthographic camera of a render (conventions above), to place mesh points in its image.
+struct RenderCamera {
+  /// Orthonormal basis: `back` points from the scene towards the camera (the viewing direction
+  /// is -back), `up` is the image's up, right = up x back.
+  Eigen::Vector3d right = Eigen::Vector3d::UnitX(), up = Eigen::Vector3d::UnitY(), back = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();  ///< the frame's centre
+  double pixels_per_unit = 1;                        ///< image scale
+  double centre_x = 0, centre_y = 0;                 ///< where the centre lands, in pixels
+  double depth_range = 1;  ///< the GL depth range is [-depth_range, depth_range] around the centre
+  int width = 0, height = 0;
+
+  /// (x, y, depth) of mesh point p: x from the image's left edge and y from its top edge in
+  /// pixels (pixel (i, j) covers [i, i + 1) x [j, j + 1)), depth along the viewing direction
+  /// from the centre's plane in mesh units (larger is farther).
+  [[nodiscard]] Eigen::Vector3d project(const Eigen::Vector3d& p) const {
+    const Eigen::Vector3d d = p - centre;
+    return {centre_x + pixels_per_unit * d.dot(right), centre_y - pixels_per_unit * d.dot(up), -d.dot(back)};
+  }
+};
+
+/// The camera render_mesh uses for `V` (its bounding box when options.frame is empty) and
+/// `options` (view, size, frame). Throws as render_mesh for a bad size or frame.
+RenderCamera render_camera(const Vertices& V, const RenderOptions& options);
+
+/// A depth buffer: per pixel the depth (RenderCamera::project's third coordinate) of the nearest
+/// surface at the pixel's centre, +infinity where there is none. Rows top to bottom.
+struct DepthImage {
+  int width = 0, height = 0;
+  std::vector<float> depth;  ///< width * height
+  RenderCamera camera;
+  [[nodiscard]] float at(int x, int y) const { return depth[static_cast<std::size_t>(y) * width + x]; }
+};
+
+/// Rasterises `mesh`'s faces with render_mesh's camera for the same options, single-sampled,
+/// into a depth buffer (both sides of every face; colours and lights unused): what hidden-line
+/// removal tests lines against. Throws as render_mesh.
+DepthImage render_depth(const Mesh& mesh, const RenderOptions& options = {});
+
 /// What a render measured, for the caller's legend text and for benchmarks.
 struct RenderInfo {
   /// The quantity's name ("mean curvature", ...), empty for RenderColor::None.
@@ -125,6 +163,8 @@ struct RenderInfo {
   double color_max = 0;
   /// The camera frame actually used.
   BoundingBox frame;
+  /// The camera actually used.
+  RenderCamera camera;
   /// Wall-clock seconds: preparing arrays (normals, colours, edges), OpenGL drawing up to
   /// glFinish, and getting the pixels into the Image (multisample resolve and copy).
   double prepare_seconds = 0;

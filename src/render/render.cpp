@@ -29,6 +29,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <numbers>
 #include <stdexcept>
@@ -292,7 +293,7 @@ void set_light(GLenum light, const Eigen::Vector3d& direction, float diffuse, fl
 }
 
 // The 4x4 column-major modelview: rows of the rotation are the camera's right, up, back.
-std::array<GLfloat, 16> modelview_matrix(const Camera& c) {
+std::array<GLfloat, 16> modelview_matrix(const RenderCamera& c) {
   std::array<GLfloat, 16> m{};
   for (int k = 0; k < 3; ++k) {
     m[4 * k + 0] = static_cast<GLfloat>(c.right[k]);
@@ -301,6 +302,15 @@ std::array<GLfloat, 16> modelview_matrix(const Camera& c) {
   }
   m[15] = 1;
   return m;
+}
+
+// glOrtho for `camera`: the camera's centre_x/centre_y pixel is the frame centre, the depth
+// range symmetric around it.
+void load_projection(const RenderCamera& c) {
+  glMatrixMode(GL_PROJECTION);
+  glLoadIdentity();
+  glOrtho(-c.centre_x / c.pixels_per_unit, (c.width - c.centre_x) / c.pixels_per_unit,
+          -(c.height - c.centre_y) / c.pixels_per_unit, c.centre_y / c.pixels_per_unit, -c.depth_range, c.depth_range);
 }
 
 // ---- Legend --------------------------------------------------------------------------------
@@ -416,15 +426,20 @@ void draw_legend(Image& image, const ColorScale& scale, const RenderOptions& opt
   }
 }
 
-void check_options(const Mesh& mesh, const RenderOptions& options) {
+// What render_camera needs: the size and the frame.
+void check_camera_options(const RenderOptions& options) {
   if (options.width < 16 || options.width > 8192 || options.height < 16 || options.height > 8192)
     throw std::invalid_argument(fmt::format("image size {}x{} is outside 16..8192", options.width, options.height));
-  if (mesh.F.rows() > 0 && (mesh.F.minCoeff() < 0 || mesh.F.maxCoeff() >= mesh.V.rows()))
-    throw std::invalid_argument("a face references a vertex that does not exist");
-  if (!mesh.V.allFinite()) throw std::invalid_argument("the mesh has non-finite vertex coordinates");
   if (options.frame && !(options.frame->min.allFinite() && options.frame->max.allFinite() &&
                          (options.frame->max.array() >= options.frame->min.array()).all()))
     throw std::invalid_argument("the camera frame is not a finite box with min <= max");
+}
+
+void check_options(const Mesh& mesh, const RenderOptions& options) {
+  check_camera_options(options);
+  if (mesh.F.rows() > 0 && (mesh.F.minCoeff() < 0 || mesh.F.maxCoeff() >= mesh.V.rows()))
+    throw std::invalid_argument("a face references a vertex that does not exist");
+  if (!mesh.V.allFinite()) throw std::invalid_argument("the mesh has non-finite vertex coordinates");
   if (options.color_limit && !(*options.color_limit > 0 && std::isfinite(*options.color_limit)))
     throw std::invalid_argument("the colour limit must be a positive finite number");
   if (!(options.wireframe_width > 0 && options.wireframe_width <= 16))
@@ -432,6 +447,83 @@ void check_options(const Mesh& mesh, const RenderOptions& options) {
 }
 
 }  // namespace
+
+RenderCamera render_camera(const Vertices& V, const RenderOptions& options) {
+  check_camera_options(options);
+  const BoundingBox frame = options.frame ? *options.frame : bounding_box(V);
+  const Camera basis = camera_for(options);
+  RenderCamera c;
+  c.right = basis.right, c.up = basis.up, c.back = basis.back;
+  c.width = options.width, c.height = options.height;
+  c.centre = 0.5 * (frame.min + frame.max);
+  double radius = 0.5 * frame.diagonal();
+  if (!(radius > 0)) radius = 1;  // a single point or an empty mesh: any scale will do
+  // Depth range: everything in the mesh, even parts outside a frame taken from another mesh.
+  double depth = radius;
+  for (Index v = 0; v < V.rows(); ++v) depth = std::max(depth, (V.row(v).transpose() - c.centre).norm());
+  c.depth_range = 1.05 * depth;
+  // The frame box as seen in this view fills 92% of the image minus the legend strip in its
+  // limiting direction, centred in that region.
+  const double region_w = options.width * (1 - kLegendWidthFraction);
+  double half_x = 0, half_y = 0;  // half-extents of the projected box
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d p((corner & 1 ? frame.max : frame.min).x(), (corner & 2 ? frame.max : frame.min).y(),
+                            (corner & 4 ? frame.max : frame.min).z());
+    half_x = std::max(half_x, std::abs((p - c.centre).dot(c.right)));
+    half_y = std::max(half_y, std::abs((p - c.centre).dot(c.up)));
+  }
+  // A box seen edge-on (a flat mesh) has no extent in one direction: the other one decides.
+  half_x = std::max(half_x, 1e-9 * radius);
+  half_y = std::max(half_y, 1e-9 * radius);
+  c.pixels_per_unit = 0.92 * std::min(region_w / (2 * half_x), options.height / (2 * half_y));
+  c.centre_x = 0.5 * region_w;
+  c.centre_y = 0.5 * options.height;
+  return c;
+}
+
+DepthImage render_depth(const Mesh& mesh, const RenderOptions& options) {
+  check_options(mesh, options);
+  DepthImage out;
+  out.camera = render_camera(mesh.V, options);
+  out.width = options.width;
+  out.height = options.height;
+  const std::size_t pixels = static_cast<std::size_t>(out.width) * static_cast<std::size_t>(out.height);
+  out.depth.assign(pixels, std::numeric_limits<float>::infinity());
+  if (mesh.F.rows() == 0) return out;
+  std::vector<float> positions(3 * static_cast<std::size_t>(mesh.V.rows()));
+  for (Index v = 0; v < mesh.V.rows(); ++v)
+    for (int k = 0; k < 3; ++k)
+      positions[3 * static_cast<std::size_t>(v) + k] = static_cast<float>(mesh.V(v, k) - out.camera.centre[k]);
+  OffscreenContext context(out.width, out.height);
+  glViewport(0, 0, out.width, out.height);
+  glClearDepth(1.0);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  load_projection(out.camera);
+  glMatrixMode(GL_MODELVIEW);
+  const std::array<GLfloat, 16> modelview = modelview_matrix(out.camera);
+  glLoadMatrixf(modelview.data());
+  glColorMask(GL_FALSE, GL_FALSE, GL_FALSE, GL_FALSE);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glEnableClientState(GL_VERTEX_ARRAY);
+  glVertexPointer(3, GL_FLOAT, 0, positions.data());
+  glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * mesh.F.rows()), GL_UNSIGNED_INT, mesh.F.data());
+  glDisableClientState(GL_VERTEX_ARRAY);
+  std::vector<float> window(pixels);
+  glReadPixels(0, 0, out.width, out.height, GL_DEPTH_COMPONENT, GL_FLOAT, window.data());
+  if (const GLenum error = glGetError(); error != GL_NO_ERROR)
+    throw std::runtime_error(fmt::format("OpenGL error 0x{:x} while rendering depth", error));
+  // Window depth w in [0, 1] is (1 + depth / range) / 2 for glOrtho(..., -range, range); rows
+  // bottom to top. 1 is the cleared far plane: no surface.
+  const double range = out.camera.depth_range;
+  for (int y = 0; y < out.height; ++y)
+    for (int x = 0; x < out.width; ++x) {
+      const float w = window[static_cast<std::size_t>(out.height - 1 - y) * out.width + x];
+      if (w < 1.0f)
+        out.depth[static_cast<std::size_t>(y) * out.width + x] = static_cast<float>((2.0 * w - 1.0) * range);
+    }
+  return out;
+}
 
 Image render_mesh(const Mesh& mesh, const RenderOptions& options, RenderInfo* info) {
   check_options(mesh, options);
@@ -445,16 +537,9 @@ Image render_mesh(const Mesh& mesh, const RenderOptions& options, RenderInfo* in
   const ScalarField field =
       mesh.F.rows() > 0 ? scalar_field(mesh, options, topology ? &*topology : nullptr) : ScalarField{};
 
-  const BoundingBox frame = options.frame ? *options.frame : bounding_box(mesh.V);
-  const Eigen::Vector3d centre = 0.5 * (frame.min + frame.max);
-  double radius = 0.5 * frame.diagonal();
-  if (!(radius > 0)) radius = 1;  // a single point or an empty mesh: any scale will do
+  const RenderCamera view = render_camera(mesh.V, options);
+  const Eigen::Vector3d centre = view.centre;
   const DrawArrays arrays = build_arrays(mesh, options, field, centre);
-  const Camera camera = camera_for(options);
-  // Depth range: everything in the mesh, even parts outside a frame taken from another mesh.
-  double depth = radius;
-  for (Index v = 0; v < mesh.num_vertices(); ++v) depth = std::max(depth, (mesh.V.row(v).transpose() - centre).norm());
-  depth *= 1.05;
   const double prepare_seconds = seconds_since(start);
 
   start = Clock::now();
@@ -465,24 +550,7 @@ Image render_mesh(const Mesh& mesh, const RenderOptions& options, RenderInfo* in
   glClearColor(bg[0] / 255.f, bg[1] / 255.f, bg[2] / 255.f, bg[3] / 255.f);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
 
-  // Orthographic projection: the frame box as seen in this view fills 92% of the image minus
-  // the legend strip in its limiting direction, centred in that region.
-  const double region_w = width * (1 - kLegendWidthFraction);
-  double half_x = 0, half_y = 0;  // half-extents of the projected box
-  for (int corner = 0; corner < 8; ++corner) {
-    const Eigen::Vector3d p((corner & 1 ? frame.max : frame.min).x(), (corner & 2 ? frame.max : frame.min).y(),
-                            (corner & 4 ? frame.max : frame.min).z());
-    half_x = std::max(half_x, std::abs((p - centre).dot(camera.right)));
-    half_y = std::max(half_y, std::abs((p - centre).dot(camera.up)));
-  }
-  // A box seen edge-on (a flat mesh) has no extent in one direction: the other one decides.
-  half_x = std::max(half_x, 1e-9 * radius);
-  half_y = std::max(half_y, 1e-9 * radius);
-  const double scale = 0.92 * std::min(region_w / (2 * half_x), height / (2 * half_y));  // pixels per unit
-  glMatrixMode(GL_PROJECTION);
-  glLoadIdentity();
-  glOrtho(-0.5 * region_w / scale, (width - 0.5 * region_w) / scale, -0.5 * height / scale, 0.5 * height / scale,
-          -depth, depth);
+  load_projection(view);
   glMatrixMode(GL_MODELVIEW);
   glLoadIdentity();
 
@@ -503,7 +571,7 @@ Image render_mesh(const Mesh& mesh, const RenderOptions& options, RenderInfo* in
   glShadeModel(GL_SMOOTH);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LEQUAL);
-  const std::array<GLfloat, 16> modelview = modelview_matrix(camera);
+  const std::array<GLfloat, 16> modelview = modelview_matrix(view);
   glLoadMatrixf(modelview.data());
 
   if (mesh.F.rows() > 0) {
@@ -559,7 +627,8 @@ Image render_mesh(const Mesh& mesh, const RenderOptions& options, RenderInfo* in
     info->color_quantity = field.scale.quantity;
     info->color_min = field.values.size() ? field.scale.lo : 0;
     info->color_max = field.values.size() ? field.scale.hi : 0;
-    info->frame = frame;
+    info->frame = options.frame ? *options.frame : bounding_box(mesh.V);
+    info->camera = view;
     info->prepare_seconds = prepare_seconds;
     info->draw_seconds = draw_seconds;
     info->readback_seconds = readback_seconds;

@@ -1,0 +1,60 @@
+// The camera options `render` and `lines` share (camera_options.h).
+#include "camera_options.h"
+
+#include <algorithm>
+#include <cctype>
+#include <map>
+#include <regex>
+
+namespace vertexflow::cli {
+
+void add_camera_options(CLI::App* command, CameraCliOptions& camera) {
+  command->add_option("--view", camera.view, "Camera direction (+y up): front (+z), side (+x), top (+y), iso, custom")
+      ->check(CLI::IsMember({"front", "side", "top", "iso", "custom"}));
+  command->add_option("--azimuth", camera.azimuth_degrees, "Custom view: degrees about +y, from +z towards +x");
+  command->add_option("--elevation", camera.elevation_degrees, "Custom view: degrees above the xz plane")
+      ->check(CLI::Range(-90.0, 90.0));
+  command->add_option("--size", camera.size, "Image size WxH in pixels (default 1600x1200)");
+  auto* frame_from =
+      command->add_option("--frame-from", camera.frame_from,
+                          "Use this mesh's bounding box as the camera frame, so renders of meshes sharing it line up");
+  command->add_option("--frame", camera.frame, "Camera frame as a box: xmin ymin zmin xmax ymax zmax")
+      ->expected(6)
+      ->delimiter(',')
+      ->excludes(frame_from);
+}
+
+void apply_camera_options(const CameraCliOptions& camera, RenderOptions& options, const GlobalOptions& global) {
+  std::smatch size;
+  if (!std::regex_match(camera.size, size, std::regex(R"((\d{1,5})[xX](\d{1,5}))")))
+    throw std::invalid_argument("--size " + camera.size + ": expected WIDTHxHEIGHT, e.g. 1600x1200");
+  options.width = std::stoi(size[1]);
+  options.height = std::stoi(size[2]);
+  const std::map<std::string, RenderView> views = {{"front", RenderView::Front},
+                                                   {"side", RenderView::Side},
+                                                   {"top", RenderView::Top},
+                                                   {"iso", RenderView::Iso},
+                                                   {"custom", RenderView::Custom}};
+  options.view = views.at(camera.view);
+  options.azimuth_degrees = camera.azimuth_degrees;
+  options.elevation_degrees = camera.elevation_degrees;
+  if (!camera.frame.empty()) {
+    const auto& f = camera.frame;
+    options.frame = BoundingBox{{f[0], f[1], f[2]}, {f[3], f[4], f[5]}};
+    if (!(options.frame->max.array() >= options.frame->min.array()).all())
+      throw std::invalid_argument("--frame: every max must be >= its min (xmin ymin zmin xmax ymax zmax)");
+  }
+  if (!camera.frame_from.empty()) options.frame = bounding_box(read_mesh_with_warnings(camera.frame_from, global).V);
+}
+
+}  // namespace vertexflow::cli
+
+namespace vertexflow::cli {
+
+std::string lowercase_extension(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+  return ext;
+}
+
+}  // namespace vertexflow::cli

@@ -1,0 +1,34 @@
+// The camera options `render` and `lines` share: --view, --azimuth, --elevation, --size,
+// --frame-from and --frame (render.h's conventions).
+#pragma once
+
+#include "cli_common.h"
+
+#include "vertexflow/render.h"
+
+namespace vertexflow::cli {
+
+struct CameraCliOptions {
+  std::string view = "iso";
+  std::string size = "1600x1200";
+  std::string frame_from;
+  std::vector<double> frame;
+  double azimuth_degrees = 30;
+  double elevation_degrees = 20;
+};
+
+/// Registers the camera options on `command`.
+void add_camera_options(CLI::App* command, CameraCliOptions& camera);
+
+/// Sets options.view, azimuth, elevation, width, height and frame (reading --frame-from's
+/// mesh). Throws std::invalid_argument for a malformed --size or --frame.
+void apply_camera_options(const CameraCliOptions& camera, RenderOptions& options, const GlobalOptions& global);
+
+}  // namespace vertexflow::cli
+
+namespace vertexflow::cli {
+
+/// The extension of `path`, lowercase, with its dot (".png"); empty when it has none.
+std::string lowercase_extension(const std::string& path);
+
+}  // namespace vertexflow::cli
