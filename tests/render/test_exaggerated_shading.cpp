@@ -215,5 +215,56 @@ TEST(ExaggeratedShading, RejectsBadOptions) {
   EXPECT_EQ(exaggerated_shading(Vertices(0, 3), Faces(0, 3), light).size(), 0);
 }
 
+// ---- Rendering -----------------------------------------------------------------------------
+
+RenderOptions small_render(RenderShading shading) {
+  RenderOptions o;
+  o.width = 320;
+  o.height = 240;
+  o.view = RenderView::Front;
+  o.shading = shading;
+  return o;
+}
+
+TEST(ExaggeratedShadingRender, GreyShadesUnlikeTheSmoothRender) {
+  const Mesh bunny = read_mesh(test::data_path("bunny_adaptive.off"));
+  const Image smooth = render_mesh(bunny, small_render(RenderShading::Smooth));
+  const Image exaggerated = render_mesh(bunny, small_render(RenderShading::Exaggerated));
+  long foreground = 0, grey = 0, differing = 0;
+  double sum = 0, sum2 = 0;
+  for (int y = 0; y < exaggerated.height; ++y)
+    for (int x = 0; x < exaggerated.width; ++x) {
+      const std::uint8_t* p = exaggerated.pixel(x, y);
+      const std::uint8_t* q = smooth.pixel(x, y);
+      const bool background = p[0] == 255 && p[1] == 255 && p[2] == 255;
+      const bool smooth_background = q[0] == 255 && q[1] == 255 && q[2] == 255;
+      if (background && smooth_background) continue;
+      differing += std::abs(p[0] - q[0]) > 8;
+      if (background) continue;
+      ++foreground;
+      grey += p[0] == p[1] && p[1] == p[2];
+      sum += p[0], sum2 += double(p[0]) * p[0];
+    }
+  const double mean = sum / foreground, spread = std::sqrt(sum2 / foreground - mean * mean);
+  std::printf("bunny render: %ld foreground pixels, %ld grey, %ld differ from smooth by > 8, grey mean %.1f sd %.1f\n",
+              foreground, grey, differing, mean, spread);
+  EXPECT_GT(foreground, 0.1 * exaggerated.width * exaggerated.height);  // not blank
+  EXPECT_EQ(grey, foreground);                                          // lighting off, colour none: greys
+  EXPECT_GT(differing, foreground / 2);                                 // measured 86%
+  EXPECT_GT(spread, 30);                                                // measured 42.3 (of 255)
+
+  // With a colour map its colours are scaled by the shades: coloured, not grey.
+  RenderOptions colored = small_render(RenderShading::Exaggerated);
+  colored.color = RenderColor::Mean;
+  colored.color_bar = false;
+  const Image tinted_image = render_mesh(bunny, colored);
+  long tinted = 0;
+  for (int y = 0; y < tinted_image.height; ++y)
+    for (int x = 0; x < tinted_image.width; ++x)
+      tinted += std::abs(tinted_image.pixel(x, y)[0] - tinted_image.pixel(x, y)[2]) > 20;
+  std::printf("mean curvature colours under exaggerated shading: %ld tinted pixels\n", tinted);
+  EXPECT_GT(tinted, foreground / 10);  // measured 35%
+}
+
 }  // namespace
 }  // namespace vertexflow
