@@ -266,5 +266,31 @@ TEST(ExaggeratedShadingRender, GreyShadesUnlikeTheSmoothRender) {
   EXPECT_GT(tinted, foreground / 10);  // measured 35%
 }
 
+TEST(ExaggeratedShadingCli, ShadingOptionAndAliases) {
+  test::ScratchDir dir("render_cli_exaggerated");
+  const std::string in = test::quoted_data_path("bunny_adaptive.off");
+  const auto run = [&](const std::string& out, const std::string& args) {
+    return test::run_cli("render " + in + " " + test::shell_quote(dir.file(out).string()) + " --size 200x150 " + args);
+  };
+  ASSERT_EQ(run("x.png", "--shading exaggerated --exaggeration 6 --scales 3 --sigma 1.5 --light 0,1,1").exit_code, 0);
+  ASSERT_EQ(run("flat.png", "--flat").exit_code, 0);
+  ASSERT_EQ(run("flat2.png", "--shading flat").exit_code, 0);
+  ASSERT_EQ(run("smooth.png", "--smooth").exit_code, 0);
+  ASSERT_EQ(run("smooth2.png", "--shading smooth").exit_code, 0);
+  EXPECT_EQ(test::read_text(dir.file("flat.png")), test::read_text(dir.file("flat2.png")));
+  EXPECT_EQ(test::read_text(dir.file("smooth.png")), test::read_text(dir.file("smooth2.png")));
+  EXPECT_NE(test::read_text(dir.file("x.png")), test::read_text(dir.file("smooth.png")));
+  EXPECT_NE(test::read_text(dir.file("flat.png")), test::read_text(dir.file("smooth.png")));
+  // Conflicting or bad options: an error and no file.
+  EXPECT_NE(run("bad1.png", "--shading exaggerated --flat").exit_code, 0);
+  EXPECT_NE(run("bad2.png", "--shading glossy").exit_code, 0);
+  EXPECT_NE(run("bad3.png", "--shading exaggerated --weights 1,2").exit_code, 0);
+  for (const char* bad : {"bad1.png", "bad2.png", "bad3.png"}) EXPECT_FALSE(std::filesystem::exists(dir.file(bad)));
+  // Exaggerated-shading options without the mode: a warning, the smooth picture.
+  const test::CommandResult r = run("warned.png", "--exaggeration 4");
+  EXPECT_EQ(r.exit_code, 0);
+  EXPECT_NE(r.err.find("only used with --shading exaggerated"), std::string::npos) << r.err;
+}
+
 }  // namespace
 }  // namespace vertexflow
