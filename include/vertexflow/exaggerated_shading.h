@@ -2,7 +2,7 @@
 // Depicting Shape and Detail", SIGGRAPH 2006, computed per vertex on the CPU. The renderer draws
 // it as per-vertex greys with lighting off (render.h, RenderShading::Exaggerated).
 //
-// The method (the paper's Sec. 3, multi-scale local toon shading)
+// The method (the paper's multi-scale local toon shading, its formula for arbitrary 3D surfaces)
 // - Normals at b + 1 scales: n_0 are the mesh's vertex normals (curvature.h), n_i for i >= 1
 //   those normals smoothed by a Gaussian of standard deviation sigma_i = sigma_1 2^(i - 1)
 //   along the surface, then normalised.
@@ -15,7 +15,9 @@
 //   is in [0, 1]: 1/2 is mid grey, where every term is 0.
 //
 // Smoothing: sigma_1 is given in mean edge lengths, so the finest scale resolves the mesh's own
-// detail and the work does not grow with the resolution (see ExaggeratedShadingOptions::sigma).
+// detail and the number of passes below does not grow with the resolution, whereas a fraction of
+// the bounding-box diagonal would need (diagonal / edge)^2 times more passes on dense meshes
+// (see ExaggeratedShadingOptions::sigma).
 // The Gaussians are approximated by repeated area-weighted averaging over each vertex's closed
 // one-ring (itself and its neighbours); a pass spreads a normal by a per-axis variance s^2
 // measured on the mesh (half the mean weighted squared distance of a pass), so scale i takes

@@ -166,8 +166,8 @@ Eigen::VectorXd exaggerated_shading(const Vertices& V, const Faces& F, const Eig
     smooth(stencil, M, scratch, target - done);
     done = target;
     normalise_into(M, fine, coarse);
-    // Paper Sec. 3: l_{i+1} = l projected on the plane perpendicular to n_{i+1} (the light made
-    // grazing for the next-coarser surface), c_i = clamp_[-1,1](a n_i . l_{i+1}).
+    // The paper's detail term: l_{i+1} = l projected on the plane perpendicular to n_{i+1}
+    // (the light made grazing for the next-coarser surface), c_i = clamp_[-1,1](a n_i . l_{i+1}).
     parallel_for_index(n, [&](Index v) {
       const Eigen::Vector3d nc = coarse.row(v).transpose();
       const Eigen::Vector3d projected = l - l.dot(nc) * nc;
