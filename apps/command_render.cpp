@@ -1,5 +1,7 @@
-// `vertexflow render IN OUT.png [--color ...] [--wireframe] [--view ...] [--size WxH] [--flat|--smooth]
+// `vertexflow render IN OUT.png [--color ...] [--wireframe] [--view ...] [--size WxH]
+// [--shading smooth|flat|exaggerated] [--exaggeration A --scales N --sigma S --weights K --light X,Y,Z]
 // [--frame-from MESH | --frame BOX] [--before MESH]`: a headless picture of a mesh (render.h).
+// --flat and --smooth are kept as aliases of --shading flat and --shading smooth.
 // The colour range is printed on stdout (and drawn, labelled, in the image's colour bar).
 #include "cli_common.h"
 
@@ -28,6 +30,12 @@ struct RenderCommandOptions {
   bool wireframe = false;
   bool flat = false;
   bool smooth = false;
+  std::string shading;
+  std::optional<double> exaggeration;
+  std::optional<int> scales;
+  std::optional<double> sigma;
+  std::vector<double> weights;
+  std::vector<double> light;
   bool no_color_bar = false;
   bool json = false;
   bool force = false;
@@ -69,6 +77,36 @@ void register_render_command(CLI::App& app, const GlobalOptions& global) {
   auto* flat = command->add_flag("--flat", o->flat, "One normal per face: every triangle visible");
   auto* smooth = command->add_flag("--smooth", o->smooth, "Interpolated vertex normals (default)");
   flat->excludes(smooth);
+  command
+      ->add_option("--shading", o->shading,
+                   "smooth (interpolated vertex normals, default), flat (one normal per face) or exaggerated "
+                   "(Rusinkiewicz et al. 2006: multi-scale shading that shows detail at every scale)")
+      ->check(CLI::IsMember({"smooth", "flat", "exaggerated"}))
+      ->excludes(flat)
+      ->excludes(smooth);
+  command
+      ->add_option("--exaggeration", o->exaggeration,
+                   "Exaggerated shading: contrast a of every scale's clamped term (default 10)")
+      ->check(CLI::PositiveNumber);
+  command
+      ->add_option("--scales", o->scales,
+                   "Exaggerated shading: number of detail scales, sigma doubling from one to the next (default 4)")
+      ->check(CLI::Range(0, 8));
+  command
+      ->add_option("--sigma", o->sigma,
+                   "Exaggerated shading: smoothing of the first detail scale in mean edge lengths (default 1)")
+      ->check(CLI::PositiveNumber);
+  command
+      ->add_option("--weights", o->weights,
+                   "Exaggerated shading: weights of the detail terms, finest first, then of the overall shape "
+                   "(scales + 1 values; default 1 each and 2 for the shape)")
+      ->delimiter(',');
+  command
+      ->add_option("--light", o->light,
+                   "Exaggerated shading: direction towards the light in camera coordinates, x right, y up, z towards "
+                   "the viewer (default -1,1,1: upper left, in front)")
+      ->expected(3)
+      ->delimiter(',');
   auto* frame_from =
       command->add_option("--frame-from", o->frame_from,
                           "Use this mesh's bounding box as the camera frame, so renders of meshes sharing it line up");
@@ -108,7 +146,20 @@ void register_render_command(CLI::App& app, const GlobalOptions& global) {
                                                        {"displacement", RenderColor::Displacement}};
     options.view = views.at(o->view);
     options.color = colors.at(o->color);
-    options.shading = o->flat ? RenderShading::Flat : RenderShading::Smooth;
+    options.shading = o->flat || o->shading == "flat" ? RenderShading::Flat
+                      : o->shading == "exaggerated"   ? RenderShading::Exaggerated
+                                                      : RenderShading::Smooth;
+    if (o->exaggeration) options.exaggerated.exaggeration = *o->exaggeration;
+    if (o->scales) options.exaggerated.scales = *o->scales;
+    if (o->sigma) options.exaggerated.sigma = *o->sigma;
+    options.exaggerated.weights = o->weights;
+    if (!o->light.empty()) options.exaggerated_light = {o->light[0], o->light[1], o->light[2]};
+    const bool exaggerated_options =
+        o->exaggeration || o->scales || o->sigma || !o->weights.empty() || !o->light.empty();
+    if (exaggerated_options && options.shading != RenderShading::Exaggerated && !global.quiet)
+      fmt::print(stderr,
+                 "vertexflow: warning: --exaggeration, --scales, --sigma, --weights and --light are only used with "
+                 "--shading exaggerated\n");
     options.wireframe = o->wireframe;
     options.color_bar = !o->no_color_bar;
     options.color_limit = o->color_limit;

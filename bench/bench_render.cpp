@@ -4,10 +4,13 @@
 // as counters (seconds): prepare (topology, normals, colours, arrays), draw (OpenGL until
 // glFinish), readback (multisample resolve, copy), png. llvmpipe uses LP_NUM_THREADS
 // rasteriser threads (default: one per core); the counter lp_threads says what it was.
+// Exaggerated shading (exaggerated_shading.h) is timed alone on horse-48k (96,966 faces, the
+// brief's "100k faces in well under a second") and as a whole render on the 1M-face bunny.
 //
 //   build/bin/bench_render --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include "bench_support.h"
 
+#include "vertexflow/exaggerated_shading.h"
 #include "vertexflow/io.h"
 #include "vertexflow/render.h"
 
@@ -38,9 +41,11 @@ int llvmpipe_threads() {
   return static_cast<int>(std::thread::hardware_concurrency());
 }
 
-void run(benchmark::State& state, const Mesh& mesh, RenderColor color, bool wireframe, int samples = 4) {
+void run(benchmark::State& state, const Mesh& mesh, RenderColor color, bool wireframe, int samples = 4,
+         RenderShading shading = RenderShading::Smooth) {
   RenderOptions options;  // 1600x1200, iso view
   options.samples = samples;
+  options.shading = shading;
   options.color = color;
   options.wireframe = wireframe;
   double prepare = 0, draw = 0, readback = 0, png = 0, bytes = 0;
@@ -78,11 +83,24 @@ void BM_RenderMeanWireframe_1M(benchmark::State& state) {
 void BM_Render_2M(benchmark::State& state) {
   run(state, large_2m(), RenderColor::None, false);
 }
+void BM_RenderExaggerated_1M(benchmark::State& state) {
+  run(state, bunny_1m(), RenderColor::None, false, 4, RenderShading::Exaggerated);
+}
+void BM_ExaggeratedShading_Horse97k(benchmark::State& state) {
+  static const Mesh horse = read_mesh(data_dir() / "horse-48k.ply");
+  for (auto _ : state) {
+    const Eigen::VectorXd shade = exaggerated_shading(horse.V, horse.F, Eigen::Vector3d(-1, 1, 1));
+    benchmark::DoNotOptimize(shade.data());
+  }
+  state.counters["faces"] = horse.num_faces();
+}
 
 BENCHMARK(BM_Render_1M)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
 BENCHMARK(BM_RenderNoAntialiasing_1M)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
 BENCHMARK(BM_RenderMeanWireframe_1M)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
 BENCHMARK(BM_Render_2M)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+BENCHMARK(BM_RenderExaggerated_1M)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(3);
+BENCHMARK(BM_ExaggeratedShading_Horse97k)->Unit(benchmark::kMillisecond)->UseRealTime()->Iterations(5);
 
 }  // namespace
 }  // namespace vertexflow::bench

@@ -95,7 +95,7 @@ def render(
     height: int = 600,
     view: Literal["front", "side", "top", "iso", "custom"] = "iso",
     color: Literal["none", "mean", "gauss", "quality", "displacement"] = "none",
-    shading: Literal["smooth", "flat"] = "smooth",
+    shading: Literal["smooth", "flat", "exaggerated"] = "smooth",
     wireframe: bool = False,
     azimuth: float = 30.0,
     elevation: float = 20.0,

@@ -558,8 +558,9 @@ py::array py_render(const py::handle& V, const py::handle& F, int width, int hei
                                             {"gauss", RenderColor::Gauss},
                                             {"quality", RenderColor::Quality},
                                             {"displacement", RenderColor::Displacement}});
-  options.shading = enum_option<RenderShading>("shading", py::str(shading),
-                                               {{"smooth", RenderShading::Smooth}, {"flat", RenderShading::Flat}});
+  options.shading = enum_option<RenderShading>(
+      "shading", py::str(shading),
+      {{"smooth", RenderShading::Smooth}, {"flat", RenderShading::Flat}, {"exaggerated", RenderShading::Exaggerated}});
   options.wireframe = wireframe;
   options.azimuth_degrees = azimuth;
   options.elevation_degrees = elevation;
@@ -761,7 +762,8 @@ distances, edge-error CV, redistribution rho, |H| percentiles, quality, degenera
         py::arg("threads") = 0,
         R"doc(Renders the mesh off-screen (OSMesa) -> (height, width, 3) uint8 RGB array, rows top to bottom.
 view: front, side, top, iso, custom (azimuth, elevation); color: none, mean, gauss, quality,
-displacement (needs displacement_reference, the positions before); shading: smooth, flat.
+displacement (needs displacement_reference, the positions before); shading: smooth, flat,
+exaggerated (Rusinkiewicz et al. 2006, render.h's default options).
 threads limits the TBB part; llvmpipe rasterises with LP_NUM_THREADS threads.)doc");
   m.def("enhance_file", &py_enhance_file, py::arg("input"), py::arg("output"),
         R"doc(enhance_file(input, output, *, force=False, metrics=True, threads=0, **flow options) -> dict

@@ -20,10 +20,13 @@
 //   +y, -z pointing up in the image), iso from the (+x, +y, +z) octant. Custom uses azimuth
 //   (degrees about +y, from +z towards +x) and elevation (degrees above the xz plane).
 // - Faces are lit on both sides (open meshes show their inside), by a light at the camera
-//   plus a weaker fill light from the upper left.
+//   plus a weaker fill light from the upper left. Exaggerated shading replaces that lighting
+//   by its own per-vertex shades (exaggerated_shading.h), from a light given in camera
+//   coordinates (RenderOptions::exaggerated_light).
 // - Image: RGBA8, rows top to bottom, 4 bytes per pixel; pixel (x, y) with y = 0 the top row.
 #pragma once
 
+#include "vertexflow/exaggerated_shading.h"
 #include "vertexflow/mesh.h"
 
 #include <array>
@@ -74,6 +77,11 @@ enum class RenderShading {
   Smooth,
   /// One normal per face: every triangle visible.
   Flat,
+  /// Exaggerated shading (Rusinkiewicz, Burns and DeCarlo 2006; exaggerated_shading.h): the
+  /// per-vertex shade s in [0, 1] of RenderOptions::exaggerated, lit from
+  /// RenderOptions::exaggerated_light, drawn with OpenGL lighting off as the grey 255 s (times
+  /// the colour map's colour when colouring by a quantity), interpolated across each triangle.
+  Exaggerated,
 };
 
 /// Fraction of the image width kept for the legend (colour bar and labels) at the right.
@@ -114,6 +122,14 @@ struct RenderOptions {
   std::string font_path = kDefaultRenderFont;
   /// Multisample anti-aliasing samples per pixel (1 = off; llvmpipe supports 4).
   int samples = 4;
+  /// RenderShading::Exaggerated: scales, smoothing, exaggeration and weights (the defaults are
+  /// documented in exaggerated_shading.h).
+  ExaggeratedShadingOptions exaggerated;
+  /// RenderShading::Exaggerated: the direction towards the light in camera coordinates, x to the
+  /// image's right, y up, z towards the viewer; need not be unit, must be finite and non-zero.
+  /// The default, from the upper left and in front, is the cartographers' convention for relief
+  /// (light from the top of the image) turned towards the viewer so most visible surface is lit.
+  Eigen::Vector3d exaggerated_light{-1, 1, 1};
 };
 
 /// The orthographic camera of a render (conventions above), to place mesh points in its image.
@@ -173,7 +189,8 @@ struct RenderInfo {
 };
 
 /// Renders `mesh` off-screen. Throws std::invalid_argument for bad options (size out of range,
-/// a displacement reference of the wrong size) and
+/// a displacement reference of the wrong size, exaggerated shading's options or light out of
+/// range) and
 /// std::runtime_error when OSMesa cannot create a context or the legend font cannot be loaded.
 /// Deterministic: the same mesh and options give the same pixels.
 Image render_mesh(const Mesh& mesh, const RenderOptions& options = {}, RenderInfo* info = nullptr);

@@ -236,6 +236,9 @@ def test_compare_simplify_remesh_render():
     image = vertexflow.render(V, F, width=64, height=48, color="mean")
     assert image.shape == (48, 64, 3) and image.dtype == np.uint8
     assert (image != 255).any() and (image == 255).any()  # the mesh on a white background
+    shaded = vertexflow.render(V, F, width=64, height=48, shading="exaggerated")
+    mesh = (shaded != 255).any(axis=2)
+    assert mesh.any() and (shaded[..., 0] == shaded[..., 2]).all()  # greys: lighting off
 
 
 # --- the GIL ---------------------------------------------------------------------------------------

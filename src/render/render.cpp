@@ -9,6 +9,7 @@
 
 #include "vertexflow/colormap.h"
 #include "vertexflow/curvature.h"
+#include "vertexflow/exaggerated_shading.h"
 #include "vertexflow/io.h"
 #include "vertexflow/quality.h"
 #include "vertexflow/timing.h"
@@ -149,8 +150,10 @@ void put3(std::vector<float>& out, std::size_t slot, const Eigen::Vector3d& v) {
   for (int k = 0; k < 3; ++k) out[3 * slot + k] = static_cast<float>(v[k]);
 }
 
+// `shades`: exaggerated shading's per-vertex shades (empty for the lit modes), which scale the
+// vertex colours from white (or the colour map's colour) down to black.
 DrawArrays build_arrays(const Mesh& mesh, const RenderOptions& options, const ScalarField& field,
-                        const Eigen::Vector3d& centre) {
+                        const Eigen::VectorXd& shades, const Eigen::Vector3d& centre) {
   const auto nv = static_cast<std::size_t>(mesh.V.rows());
   const auto nf = static_cast<std::size_t>(mesh.F.rows());
   const bool flat = options.shading == RenderShading::Flat;
@@ -160,10 +163,16 @@ DrawArrays build_arrays(const Mesh& mesh, const RenderOptions& options, const Sc
   for (std::size_t v = 0; v < nv; ++v)
     put3(a.mesh_positions, v, mesh.V.row(static_cast<Index>(v)).transpose() - centre);
 
-  const std::uint8_t plain[3] = {205, 205, 210};
+  const bool shaded = shades.size() > 0;
+  const std::uint8_t plain[3] = {205, 205, 210}, white[3] = {255, 255, 255};
+  const std::uint8_t* base = shaded ? white : plain;
   const Colors colors = field.values.size() ? field.scale.colors(field.values) : Colors();
-  const auto color_of = [&](std::size_t i, std::size_t slot) {
-    for (int k = 0; k < 3; ++k) a.rgba[4 * slot + k] = colors.rows() ? colors(static_cast<Index>(i), k) : plain[k];
+  // i: the index of the colour (a face for per-face fields), v: the mesh vertex of the slot.
+  const auto color_of = [&](std::size_t i, std::size_t v, std::size_t slot) {
+    for (int k = 0; k < 3; ++k) {
+      const std::uint8_t c = colors.rows() ? colors(static_cast<Index>(i), k) : base[k];
+      a.rgba[4 * slot + k] = shaded ? static_cast<std::uint8_t>(std::lround(c * shades[static_cast<Index>(v)])) : c;
+    }
     a.rgba[4 * slot + 3] = 255;
   };
 
@@ -174,7 +183,7 @@ DrawArrays build_arrays(const Mesh& mesh, const RenderOptions& options, const Sc
     a.rgba.resize(4 * nv);
     for (std::size_t v = 0; v < nv; ++v) {
       put3(a.normals, v, N.row(static_cast<Index>(v)).transpose());
-      color_of(v, v);
+      color_of(v, v, v);
     }
     return a;
   }
@@ -192,7 +201,7 @@ DrawArrays build_arrays(const Mesh& mesh, const RenderOptions& options, const Sc
       const std::size_t slot = 3 * f + static_cast<std::size_t>(k);
       std::copy_n(&a.mesh_positions[3 * static_cast<std::size_t>(v)], 3, &a.positions[3 * slot]);
       put3(a.normals, slot, flat ? face_n : Eigen::Vector3d(N.row(v).transpose()));
-      color_of(field.per_face ? f : static_cast<std::size_t>(v), slot);
+      color_of(field.per_face ? f : static_cast<std::size_t>(v), static_cast<std::size_t>(v), slot);
     }
   }
   return a;
@@ -444,6 +453,9 @@ void check_options(const Mesh& mesh, const RenderOptions& options) {
     throw std::invalid_argument("the colour limit must be a positive finite number");
   if (!(options.wireframe_width > 0 && options.wireframe_width <= 16))
     throw std::invalid_argument("wireframe width must be in (0, 16] pixels");
+  if (options.shading == RenderShading::Exaggerated &&
+      !(options.exaggerated_light.allFinite() && options.exaggerated_light.norm() > 0))
+    throw std::invalid_argument("the exaggerated shading light must be a finite non-zero direction");
 }
 
 }  // namespace
@@ -539,7 +551,14 @@ Image render_mesh(const Mesh& mesh, const RenderOptions& options, RenderInfo* in
 
   const RenderCamera view = render_camera(mesh.V, options);
   const Eigen::Vector3d centre = view.centre;
-  const DrawArrays arrays = build_arrays(mesh, options, field, centre);
+  const bool exaggerated = options.shading == RenderShading::Exaggerated;
+  Eigen::VectorXd shades;
+  if (exaggerated && mesh.F.rows() > 0) {
+    const Eigen::Vector3d& l = options.exaggerated_light;  // camera coordinates
+    shades =
+        exaggerated_shading(mesh.V, mesh.F, l.x() * view.right + l.y() * view.up + l.z() * view.back, options.exaggerated);
+  }
+  const DrawArrays arrays = build_arrays(mesh, options, field, shades, centre);
   const double prepare_seconds = seconds_since(start);
 
   start = Clock::now();
@@ -566,7 +585,8 @@ Image render_mesh(const Mesh& mesh, const RenderOptions& options, RenderInfo* in
   glMaterialf(GL_FRONT_AND_BACK, GL_SHININESS, 40);
   glColorMaterial(GL_FRONT_AND_BACK, GL_AMBIENT_AND_DIFFUSE);
   glEnable(GL_COLOR_MATERIAL);
-  glEnable(GL_LIGHTING);
+  // Exaggerated shading is already in the vertex colours.
+  if (!exaggerated) glEnable(GL_LIGHTING);
   glEnable(GL_NORMALIZE);  // normals are unit, but float rounding is not
   glShadeModel(GL_SMOOTH);
   glEnable(GL_DEPTH_TEST);

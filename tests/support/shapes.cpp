@@ -208,6 +208,30 @@ Mesh rounded_cube(double core, double radius, int n) {
   return from_lists(p, f);
 }
 
+Mesh roof(int n, bool across) {
+  Mesh mesh;
+  mesh.V.resize((n + 1) * (n + 1), 3);
+  auto at = [n](int i, int j) { return static_cast<Index>(j * (n + 1) + i); };
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      const double x = static_cast<double>(i) / n, y = static_cast<double>(j) / n;
+      mesh.V.row(at(i, j)) << x, y, -std::abs(x - y) / 2;
+    }
+  mesh.F.resize(2 * n * n, 3);
+  Index f = 0;
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      if (across) {
+        mesh.F.row(f++) << at(i, j), at(i + 1, j), at(i, j + 1);
+        mesh.F.row(f++) << at(i + 1, j), at(i + 1, j + 1), at(i, j + 1);
+      } else {
+        mesh.F.row(f++) << at(i, j), at(i + 1, j), at(i + 1, j + 1);
+        mesh.F.row(f++) << at(i, j), at(i + 1, j + 1), at(i, j + 1);
+      }
+    }
+  return mesh;
+}
+
 Mesh saddle(double half, int n) {
   std::vector<Eigen::Vector3d> p;
   for (int i = 0; i <= n; ++i) {
