@@ -3,16 +3,14 @@
 // [--frame-from MESH | --frame BOX] [--before MESH]`: a headless picture of a mesh (render.h).
 // --flat and --smooth are kept as aliases of --shading flat and --shading smooth.
 // The colour range is printed on stdout (and drawn, labelled, in the image's colour bar).
+#include "camera_options.h"
 #include "cli_common.h"
 
 #include "vertexflow/render.h"
 
 #include <fmt/format.h>
 
-#include <algorithm>
-#include <cctype>
 #include <map>
-#include <regex>
 
 namespace vertexflow::cli {
 namespace {
@@ -21,11 +19,8 @@ struct RenderCommandOptions {
   std::string input;
   std::string output;
   std::string color = "none";
-  std::string view = "iso";
-  std::string size = "1600x1200";
   std::string before;
-  std::string frame_from;
-  std::vector<double> frame;
+  CameraCliOptions camera;
   std::optional<double> color_limit;
   bool wireframe = false;
   bool flat = false;
@@ -41,12 +36,6 @@ struct RenderCommandOptions {
   bool force = false;
   RenderOptions render;
 };
-
-bool has_png_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  return ext == ".png";
-}
 
 nlohmann::json box_json(const BoundingBox& box) {
   return {box.min.x(), box.min.y(), box.min.z(), box.max.x(), box.max.y(), box.max.z()};
@@ -68,12 +57,7 @@ void register_render_command(CLI::App& app, const GlobalOptions& global) {
   command->add_option("--before", o->before,
                       "The mesh before the flow (same vertices and order), for --color displacement");
   command->add_flag("--wireframe", o->wireframe, "Draw the edges on the surface");
-  command->add_option("--view", o->view, "Camera direction (+y up): front (+z), side (+x), top (+y), iso, custom")
-      ->check(CLI::IsMember({"front", "side", "top", "iso", "custom"}));
-  command->add_option("--azimuth", o->render.azimuth_degrees, "Custom view: degrees about +y, from +z towards +x");
-  command->add_option("--elevation", o->render.elevation_degrees, "Custom view: degrees above the xz plane")
-      ->check(CLI::Range(-90.0, 90.0));
-  command->add_option("--size", o->size, "Image size WxH in pixels (default 1600x1200)");
+  add_camera_options(command, o->camera);
   auto* flat = command->add_flag("--flat", o->flat, "One normal per face: every triangle visible");
   auto* smooth = command->add_flag("--smooth", o->smooth, "Interpolated vertex normals (default)");
   flat->excludes(smooth);
@@ -107,13 +91,6 @@ void register_render_command(CLI::App& app, const GlobalOptions& global) {
                    "the viewer (default -1,1,1: upper left, in front)")
       ->expected(3)
       ->delimiter(',');
-  auto* frame_from =
-      command->add_option("--frame-from", o->frame_from,
-                          "Use this mesh's bounding box as the camera frame, so renders of meshes sharing it line up");
-  command->add_option("--frame", o->frame, "Camera frame as a box: xmin ymin zmin xmax ymax zmax")
-      ->expected(6)
-      ->delimiter(',')
-      ->excludes(frame_from);
   command
       ->add_option("--range", o->color_limit,
                    "Fixed colour limit L: [-L, L] for curvature, [0, L] for displacement (default: the "
@@ -125,26 +102,16 @@ void register_render_command(CLI::App& app, const GlobalOptions& global) {
   command->add_flag("--json", o->json, "Print the colour range, camera frame and timings as JSON on stdout");
   command->add_flag("--force", o->force, "Allow OUT to be one of the input files");
   command->callback([o, &global] {
-    if (!has_png_extension(o->output)) throw IoError(o->output + ": the output must be a .png file");
-    check_outputs({o->input, o->before, o->frame_from}, {{o->output, /*mesh=*/false, /*may_replace_input=*/true}},
-                  o->force);
+    if (lowercase_extension(o->output) != ".png") throw IoError(o->output + ": the output must be a .png file");
+    check_outputs({o->input, o->before, o->camera.frame_from},
+                  {{o->output, /*mesh=*/false, /*may_replace_input=*/true}}, o->force);
     RenderOptions options = o->render;
-    std::smatch size;
-    if (!std::regex_match(o->size, size, std::regex(R"((\d{1,5})[xX](\d{1,5}))")))
-      throw std::invalid_argument("--size " + o->size + ": expected WIDTHxHEIGHT, e.g. 1600x1200");
-    options.width = std::stoi(size[1]);
-    options.height = std::stoi(size[2]);
-    const std::map<std::string, RenderView> views = {{"front", RenderView::Front},
-                                                     {"side", RenderView::Side},
-                                                     {"top", RenderView::Top},
-                                                     {"iso", RenderView::Iso},
-                                                     {"custom", RenderView::Custom}};
+    apply_camera_options(o->camera, options, global);
     const std::map<std::string, RenderColor> colors = {{"none", RenderColor::None},
                                                        {"mean", RenderColor::Mean},
                                                        {"gauss", RenderColor::Gauss},
                                                        {"quality", RenderColor::Quality},
                                                        {"displacement", RenderColor::Displacement}};
-    options.view = views.at(o->view);
     options.color = colors.at(o->color);
     options.shading = o->flat || o->shading == "flat" ? RenderShading::Flat
                       : o->shading == "exaggerated"   ? RenderShading::Exaggerated
@@ -163,14 +130,8 @@ void register_render_command(CLI::App& app, const GlobalOptions& global) {
     options.wireframe = o->wireframe;
     options.color_bar = !o->no_color_bar;
     options.color_limit = o->color_limit;
-    if (!o->frame.empty()) {
-      options.frame = BoundingBox{{o->frame[0], o->frame[1], o->frame[2]}, {o->frame[3], o->frame[4], o->frame[5]}};
-      if (!(options.frame->max.array() >= options.frame->min.array()).all())
-        throw std::invalid_argument("--frame: every max must be >= its min (xmin ymin zmin xmax ymax zmax)");
-    }
 
     const Mesh mesh = read_mesh_with_warnings(o->input, global);
-    if (!o->frame_from.empty()) options.frame = bounding_box(read_mesh_with_warnings(o->frame_from, global).V);
     if (options.color == RenderColor::Displacement) {
       if (o->before.empty()) throw std::invalid_argument("--color displacement needs --before MESH");
       Mesh before = read_mesh_with_warnings(o->before, global);
