@@ -33,6 +33,11 @@ void add_line_options(CLI::App* command, LineCliOptions& o) {
                    "Ridges need k1 >= T / L, valleys -k2 >= T / L (default 25)")
       ->check(CLI::NonNegativeNumber);
   command
+      ->add_option("--smoothing-scale", o.lines.smoothing_scale,
+                   "Smooth the curvature over sigma = S * L instead of one ring (lines.h; default: 0 = one ring for "
+                   "lines, 0.01 for compare-lines)")
+      ->check(CLI::NonNegativeNumber);
+  command
       ->add_option("--length-scale", o.lines.length_scale,
                    "L of the thresholds in mesh units (default: the bounding-box diagonal)")
       ->check(CLI::NonNegativeNumber);
@@ -140,6 +145,7 @@ void register_compare_lines_command(CLI::App& app, const GlobalOptions& global) 
       "compare-lines",
       "Line-drawing fidelity of COARSE against DENSE: precision, recall and F1 of line pixels within 2 px, "
       "averaged over views around the model");
+  o->lines.lines.smoothing_scale = default_fidelity_drawing().lines.smoothing_scale;
   command->add_option("COARSE", o->coarse, "The mesh to judge")->required();
   command->add_option("DENSE", o->dense, "The dense (reference) mesh")->required();
   command->add_option("--views", o->fidelity.views, "Azimuths evenly spaced around +y (default 8)")

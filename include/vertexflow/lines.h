@@ -79,6 +79,12 @@ struct LineOptions {
   /// Curvature estimation for suggestive contours, ridges and valleys. One round of tensor
   /// smoothing, since the lines follow derivatives of curvature, which amplify noise.
   CurvatureOptions curvature{NormalWeighting::Max1999, 1};
+  /// When > 0, the curvature is smoothed over a fixed distance instead of a fixed number of
+  /// rings: sigma = smoothing_scale * L, with as many rounds of one-ring averaging as a
+  /// Gaussian of that sigma needs at the mesh's mean edge length e (sigma^2 / (0.43 e^2), at
+  /// least curvature.smoothing_rounds, at most 400; each round spreads by about 0.43 e^2 per
+  /// axis). A coarse and a dense mesh then show the same features, not each its own noise.
+  double smoothing_scale = 0;
 };
 
 /// The occluding contours of (V, F) seen from `view`, with per-vertex unit `normals` (#V x 3,
