@@ -3,6 +3,7 @@
 #include "report_support.h"
 
 #include "vertexflow/io.h"
+#include "vertexflow/provenance.h"
 #include "vertexflow/report_json.h"
 #include "vertexflow/timing.h"
 #include "vertexflow/topology.h"
@@ -65,11 +66,14 @@ void run_file(const std::filesystem::path& input, const std::filesystem::path& o
                     r.held_non_manifold_vertices, r.reoriented_faces, r.cut_edges));
   row.warnings = join(warnings);
 
-  // As `vertexflow enhance`: same connectivity and colours, no vertex properties.
+  // As `vertexflow enhance`: same connectivity and colours, no vertex properties, the input's
+  // comments and the paper's flow's provenance line (provenance.h).
   Mesh out;
   out.V = std::move(result.V);
   out.F = mesh.F;
   out.colors = mesh.colors;
+  out.comments = mesh.comments;
+  append_provenance(out.comments, provenance_line({}));
   start = Clock::now();
   write_mesh(output, out);
   row.seconds_write = seconds_since(start);

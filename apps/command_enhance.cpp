@@ -8,6 +8,7 @@
 #include "vertexflow/fit.h"
 #include "vertexflow/flow.h"
 #include "vertexflow/html_report.h"
+#include "vertexflow/provenance.h"
 #include "vertexflow/quality.h"
 #include "vertexflow/report_json.h"
 #include "vertexflow/timing.h"
@@ -209,10 +210,18 @@ MethodRun run_reference(const Mesh& mesh, const Mesh& reference, const FitOption
 
 // Smooth mode (fit.h): the vertices fitted to the PN-triangle estimate through them. Report: as
 // reference mode, and the estimate's options.
-MethodRun run_smooth(const Mesh& mesh, const SmoothFitOptions& options, const Progress& phase, const Progress& warn) {
+// `fitted_by` is the input's comment that records an earlier fit (provenance.h), or nullptr.
+MethodRun run_smooth(const Mesh& mesh, const SmoothFitOptions& options, const std::string* fitted_by,
+                     const Progress& phase, const Progress& warn) {
   FitResult result = fit_to_smooth_surface(mesh.V, mesh.F, options);
   const FitReport& r = result.report;
-  if (r.held_as_decimated)
+  if (r.held_as_fitted)
+    warn(
+        fmt::format("its provenance comment '{}' records an earlier fit, which left the vertices off the surface "
+                    "the faces inscribe: smooth mode, which assumes them on it, held every vertex (provenance.h; "
+                    "--assume-on-surface fits anyway)",
+                    fitted_by ? *fitted_by : std::string()));
+  else if (r.held_as_decimated)
     warn(
         fmt::format("{:.1f}% of the faces are below quality 0.3, as on decimated meshes, whose vertices lie off "
                     "the surface: smooth mode, which assumes them on it, held every vertex (fit.h; "
@@ -228,6 +237,8 @@ MethodRun run_smooth(const Mesh& mesh, const SmoothFitOptions& options, const Pr
   run.report = r;
   run.report["fit"]["poor_face_fraction"] = r.poor_face_fraction;
   run.report["fit"]["held_as_decimated"] = r.held_as_decimated;
+  run.report["fit"]["held_as_fitted"] = r.held_as_fitted;
+  run.report["fit"]["fitted_by"] = r.held_as_fitted && fitted_by ? nlohmann::json(*fitted_by) : nlohmann::json();
   run.report["options"] = options.fit;
   for (const char* unused : {"samples_per_vertex", "mesh_to_reference_weight", "seed"})
     run.report["options"].erase(unused);
@@ -429,6 +440,11 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     o->smooth.fit.sliver_floor = o->fit.sliver_floor;
     if (command->count("--max-rounds") > 0) o->smooth.fit.max_rounds = o->fit.max_rounds;
     if (o->assume_on_surface) o->smooth.max_poor_face_fraction = 1.0;
+    // Smooth mode holds an input that an earlier fit already moved off the inscribed surface.
+    // The paper's flow (--surface input) does not count: it keeps the vertices on its input's
+    // surface (provenance.h).
+    const std::string* fitted_by = find_fit_provenance(mesh.comments);
+    o->smooth.already_fitted = fitted_by != nullptr && !o->assume_on_surface;
     Mesh reference;
     if (on_reference) {
       phase("reading " + o->reference_file);
@@ -457,7 +473,7 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
       if (fit) {
         run = run_reference(mesh, reference, o->fit, phase);
       } else if (smooth) {
-        run = run_smooth(mesh, o->smooth, phase, warn);
+        run = run_smooth(mesh, o->smooth, fitted_by, phase, warn);
       } else if (unsharp) {
         run = run_unsharp(mesh, o->unsharp, warn);
       } else {
@@ -476,6 +492,29 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     out.F = mesh.F;
     out.colors = mesh.colors;
     if (o->edge_flips) run.report["edge_flips"] = flip_and_refit(mesh, reference, *o, out, phase);
+    // The input's provenance and a line for this run, so a chain of runs stays visible and a
+    // later smooth-mode run can tell a fitted input (provenance.h).
+    ProvenanceRun provenance;
+    provenance.mode = fit              ? EnhanceMode::ReferenceFit
+                      : reference_flow ? EnhanceMode::ReferenceFlow
+                      : smooth         ? EnhanceMode::Smooth
+                      : unsharp        ? EnhanceMode::Unsharp
+                                       : EnhanceMode::Flow;
+    provenance.reference = o->reference_file;
+    provenance.edge_flips = o->edge_flips;
+    provenance.assume_on_surface = o->assume_on_surface;
+    if (smooth && run.report["fit"]["held_as_fitted"].get<bool>()) provenance.held = "already fitted";
+    if (smooth && run.report["fit"]["held_as_decimated"].get<bool>()) provenance.held = "decimated";
+    const std::string provenance_text = provenance_line(provenance);
+    out.comments = mesh.comments;
+    append_provenance(out.comments, provenance_text);
+    run.report["provenance"] = provenance_text;
+    if (records_fit(provenance_text) && format_from_path(o->output) == MeshFormat::Stl && !global.quiet)
+      fmt::print(stderr,
+                 "vertexflow: warning: {}: STL keeps no comments, so the provenance line '{}' is lost: a later "
+                 "--surface smooth run cannot tell that this mesh is already fitted (write PLY, OBJ or OFF to keep "
+                 "it)\n",
+                 o->output, provenance_text);
     start = std::chrono::steady_clock::now();
     phase("writing " + o->output);
     write_mesh(o->output, out);

@@ -7,7 +7,7 @@ threads (0: all cores). Nothing is printed; progress goes to the optional callba
 """
 
 import os
-from typing import Any, Callable, Iterable, Literal, NamedTuple, Sequence
+from typing import Any, Callable, Iterable, Literal, NamedTuple, Sequence, overload
 
 import numpy as np
 import numpy.typing as npt
@@ -29,8 +29,17 @@ class PrincipalCurvatures(NamedTuple):
 
 def as_vertices(V: _Vertices) -> npt.NDArray[np.float64]: ...
 def as_faces(F: _Faces, num_vertices: int) -> npt.NDArray[np.int64]: ...
-def read_mesh(path: _Path) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int32]]: ...
-def write_mesh(path: _Path, V: _Vertices, F: _Faces, *, ascii: bool = False) -> None: ...
+@overload
+def read_mesh(
+    path: _Path, *, comments: Literal[False] = False
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int32]]: ...
+@overload
+def read_mesh(
+    path: _Path, *, comments: Literal[True]
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int32], list[str]]: ...
+def write_mesh(
+    path: _Path, V: _Vertices, F: _Faces, *, ascii: bool = False, comments: Sequence[str] | None = None
+) -> None: ...
 def principal_curvatures(
     V: _Vertices, F: _Faces, *, smoothing_rounds: int = 0, threads: int = 0
 ) -> PrincipalCurvatures: ...
@@ -62,6 +71,7 @@ def enhance(
     max_rounds: int | None = None,
     reference_method: Literal["fit", "flow"] = "fit",
     assume_on_surface: bool = False,
+    provenance: Sequence[str] | None = None,
     threads: int = 0,
     progress: Callable[[str], Any] | None = None,
 ) -> tuple[npt.NDArray[np.float64], dict[str, Any]]: ...

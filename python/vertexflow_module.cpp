@@ -18,6 +18,7 @@
 #include "vertexflow/fit.h"
 #include "vertexflow/flow.h"
 #include "vertexflow/io.h"
+#include "vertexflow/provenance.h"
 #include "vertexflow/remesh.h"
 #include "vertexflow/render.h"
 #include "vertexflow/report_json.h"
@@ -328,20 +329,39 @@ void report_progress(const py::object& progress, const std::string& message) {
 // ---------------------------------------------------------------------------------------------
 // The functions
 
-py::tuple py_read_mesh(const std::filesystem::path& path) {
+py::tuple py_read_mesh(const std::filesystem::path& path, bool comments) {
   Mesh mesh;
   {
     py::gil_scoped_release release;
     mesh = read_mesh(path);
   }
-  return mesh_tuple(std::move(mesh));
+  if (!comments) return mesh_tuple(std::move(mesh));
+  py::list lines;
+  for (const std::string& line : mesh.comments) lines.append(line);
+  const py::tuple pair = mesh_tuple(std::move(mesh));
+  return py::make_tuple(pair[0], pair[1], lines);
 }
 
-void py_write_mesh(const std::filesystem::path& path, const py::handle& V, const py::handle& F, bool ascii) {
+// A sequence of str (not a str itself, which would read as one line per character).
+std::vector<std::string> string_lines(const py::object& lines, const char* what) {
+  std::vector<std::string> out;
+  if (lines.is_none()) return out;
+  if (py::isinstance<py::str>(lines) || !py::isinstance<py::sequence>(lines))
+    throw py::value_error(std::string(what) + " must be a sequence of str (one per line)");
+  for (const py::handle item : lines) {
+    if (!py::isinstance<py::str>(item)) throw py::value_error(std::string(what) + " must be a sequence of str");
+    out.push_back(item.cast<std::string>());
+  }
+  return out;
+}
+
+void py_write_mesh(const std::filesystem::path& path, const py::handle& V, const py::handle& F, bool ascii,
+                   const py::object& comments) {
   MeshArgs args = mesh_args(V, F);
   Mesh mesh;
   mesh.V = std::move(args.V);
   mesh.F = std::move(args.F);
+  mesh.comments = string_lines(comments, "comments");
   WriteOptions options;
   if (ascii) {
     options.ply_encoding = PlyEncoding::Ascii;
@@ -372,6 +392,8 @@ py::tuple py_enhance(const py::handle& V, const py::handle& F, const py::kwargs&
   const py::object reference = pop_option<py::object>(rest, "reference", py::none());
   const py::object max_rounds = pop_option<py::object>(rest, "max_rounds", py::none());
   const bool assume_on_surface = pop_option<bool>(rest, "assume_on_surface", false);
+  const std::vector<std::string> provenance =
+      string_lines(pop_option<py::object>(rest, "provenance", py::none()), "provenance");
   const auto reference_method = pop_option<std::string>(rest, "reference_method", "fit");
   const int threads = pop_option<int>(rest, "threads", 0);
   const py::object progress = pop_option<py::object>(rest, "progress", py::none());
@@ -416,6 +438,9 @@ py::tuple py_enhance(const py::handle& V, const py::handle& F, const py::kwargs&
     smooth.fit.max_rounds = fit_options.max_rounds;
   }
   if (assume_on_surface) smooth.max_poor_face_fraction = 1.0;
+  // As the CLI: an input whose provenance records a fit is held (provenance.h).
+  const std::string* fitted_by = find_fit_provenance(provenance);
+  smooth.already_fitted = fitted_by != nullptr && !assume_on_surface;
 
   const std::string method = fit                   ? "reference"
                              : reference_flow      ? "reference-flow"
@@ -438,6 +463,8 @@ py::tuple py_enhance(const py::handle& V, const py::handle& F, const py::kwargs&
       report["options"]["max_poor_face_fraction"] = smooth.max_poor_face_fraction;
       report["fit"]["poor_face_fraction"] = r.report.poor_face_fraction;
       report["fit"]["held_as_decimated"] = r.report.held_as_decimated;
+      report["fit"]["held_as_fitted"] = r.report.held_as_fitted;
+      report["fit"]["fitted_by"] = r.report.held_as_fitted ? nlohmann::json(*fitted_by) : nlohmann::json();
       out = std::move(r.V);
     } else {
       FlowResult r = reference_flow ? vertex_flow_on_reference(args.V, args.F, ref.V, ref.F, flow)
@@ -451,6 +478,15 @@ py::tuple py_enhance(const py::handle& V, const py::handle& F, const py::kwargs&
     }
   });
   report["method"] = method;
+  ProvenanceRun run;
+  run.mode = fit                   ? EnhanceMode::ReferenceFit
+             : reference_flow      ? EnhanceMode::ReferenceFlow
+             : surface == "smooth" ? EnhanceMode::Smooth
+                                   : EnhanceMode::Flow;
+  run.assume_on_surface = assume_on_surface;
+  if (surface == "smooth" && report["fit"]["held_as_fitted"].get<bool>()) run.held = "already fitted";
+  if (surface == "smooth" && report["fit"]["held_as_decimated"].get<bool>()) run.held = "decimated";
+  report["provenance"] = provenance_line(run);
   report_progress(progress, "enhance: done");
   return py::make_tuple(to_numpy(std::move(out)), to_python(report));
 }
@@ -713,15 +749,19 @@ when it is one already (no copy), else a converted copy. Raises ValueError other
       R"doc(F as the module uses it: a C-contiguous int64 (m, 3) array, m > 0, every index in
 [0, num_vertices). Returns F itself when it is one already. Raises ValueError otherwise.)doc");
 
-  m.def("read_mesh", &py_read_mesh, py::arg("path"),
+  m.def("read_mesh", &py_read_mesh, py::arg("path"), py::kw_only(), py::arg("comments") = false,
         R"doc(Reads a mesh (OBJ, PLY, OFF, STL, optionally .gz) into (V, F): V (n, 3) float64, F (m, 3) int32.
-Polygons are triangulated and the mesh cleaned as vertexflow's reader does (io.h). Raises OSError
-with "FILE: problem" for any file problem.)doc");
+Polygons are triangulated and the mesh cleaned as vertexflow's reader does (io.h). comments=True
+returns (V, F, comments): the file's comment lines as a list of str (PLY `comment`, OBJ and OFF
+'#' lines; at most 256, each cut to 1024 bytes), which hold the provenance lines of
+`vertexflow enhance` (pass them to enhance(provenance=...)). Raises OSError with "FILE: problem"
+for any file problem.)doc");
   m.def("write_mesh", &py_write_mesh, py::arg("path"), py::arg("V"), py::arg("F"), py::kw_only(),
-        py::arg("ascii") = false,
+        py::arg("ascii") = false, py::arg("comments") = py::none(),
         R"doc(Writes (V, F) atomically (temporary file, then rename); the format follows the extension
 (.obj, .ply, .off, .stl, optionally .gz). PLY keeps float64 coordinates exactly. ascii=True writes
-ASCII PLY/STL. Raises ValueError for bad arrays, OSError for file problems.)doc");
+ASCII PLY/STL. comments, a sequence of str, are written as comment lines (PLY, OBJ, ASCII OFF;
+STL and binary OFF have none). Raises ValueError for bad arrays, OSError for file problems.)doc");
   m.def("principal_curvatures", &py_principal_curvatures, py::arg("V"), py::arg("F"), py::kw_only(),
         py::arg("smoothing_rounds") = 0, py::arg("threads") = 0,
         R"doc(Principal curvatures (Rusinkiewicz 2004) of every vertex: PrincipalCurvatures(k1, k2, T1, T2, N),
@@ -732,17 +772,21 @@ k1 >= k2 (n,) arrays, T1, T2, N unit (n, 3) arrays. Convex with outward normals 
         project_to_input=True, feature_angle=40.0, fix_boundary=True, refuse_non_manifold=False,
         max_halvings=30, min_quality=0.3, sliver_floor=0.5, curvature_smoothing_rounds=0,
         normal_weighting="max1999", solver="automatic", solver_tolerance=1e-7, max_rounds=None,
-        reference_method="fit", assume_on_surface=False, threads=0, progress=None) -> (V_out, report)
+        reference_method="fit", assume_on_surface=False, provenance=None, threads=0,
+        progress=None) -> (V_out, report)
 
 Moves the vertices of (V, F) by vertex flow (same connectivity); every FlowOptions field is a
 keyword (flow.h documents them). surface="smooth" or reference=(V_ref, F_ref) fit the vertices
 instead, as `vertexflow enhance --surface smooth` / `--reference` do (max_rounds applies to them;
 None keeps each mode's default: 10 rounds for the reference, 1 for smooth). reference_method="flow"
 runs the paper's flow on the reference (`--reference-method flow`); assume_on_surface=True fits
-smooth mode's input even when it looks decimated (`--assume-on-surface`).
+smooth mode's input even when it looks decimated (`--assume-on-surface`). provenance, the input's
+comment lines (read_mesh(path, comments=True)), lets smooth mode hold an input that an earlier
+smooth-mode or reference-mode fit placed off its surface, as the CLI does (report["fit"]
+["held_as_fitted"], ["fitted_by"]); assume_on_surface=True fits it anyway.
 V_out is bit for bit what `vertexflow enhance` writes for the same options. report is the dict of
-the enhance report's method sections (options, solver, guard, seconds). progress(str) is called
-before and after.)doc");
+the enhance report's method sections (options, solver, guard, seconds) and "provenance", the
+line the CLI would add to the output's comments. progress(str) is called before and after.)doc");
   m.def("compare", &py_compare, py::arg("V_result"), py::arg("F_result"), py::arg("V_input"), py::arg("F_input"),
         py::kw_only(), py::arg("reference") = py::none(), py::arg("threads") = 0,
         R"doc(Every figure of docs/metrics.md for a result against its input (and a dense reference=(V, F)):

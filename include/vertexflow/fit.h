@@ -89,6 +89,8 @@ struct FitReport {
   /// as decimated for exceeding SmoothFitOptions::max_poor_face_fraction (returned unchanged).
   double poor_face_fraction = 0;
   bool held_as_decimated = false;
+  /// Smooth mode: the input was held as already fitted (SmoothFitOptions::already_fitted).
+  bool held_as_fitted = false;
 };
 
 struct FitResult {
@@ -138,12 +140,19 @@ Mesh smooth_surface_estimate(const Vertices& V, const Faces& F, const SmoothSurf
 /// Measured fractions: 5.6-10.7% on those four QEM outputs, 0% on the remeshes, at most 1.9%
 /// on the data meshes that are not decimated (fertility); camelhead (7.6%) and max-planck-5k
 /// (8.8%) are decimated scans. A previous run of smooth mode keeps the input's triangle
-/// shapes and is not detected (a second run moves the mesh further out; docs/results.md).
+/// shapes, so its mark is in the file instead: the provenance line each run of `enhance` writes
+/// (provenance.h). An input whose comments record a smooth-mode or reference-mode fit is held
+/// as already fitted (already_fitted; on bunny_adaptive the first run lowers the mean distance
+/// by 30%, and a second, fitted anyway, raises the first's by 37%; docs/results.md).
 struct SmoothFitOptions {
   SmoothSurfaceOptions surface;
   /// Inputs with a larger fraction of faces below quality 0.3 are held as decimated (above);
   /// 1 fits every input.
   double max_poor_face_fraction = 0.03;
+  /// The caller knows the vertices were placed off the surface by an earlier fit (the input's
+  /// provenance, find_fit_provenance in provenance.h): the input is returned unchanged, with
+  /// FitReport::held_as_fitted set, before the quality test.
+  bool already_fitted = false;
   /// The fit's weights and guard; one round (above). samples_per_vertex, mesh_to_reference_weight
   /// and seed are not used: the data are the patches' points. No fairness: every face has data,
   /// so the proximity term alone keeps the solve definite, and the system keeps the faces'

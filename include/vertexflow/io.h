@@ -11,6 +11,14 @@
 //   order or orientation) and zero-area faces (area < kDegenerateAreaRelative * diagonal^2) are
 //   removed, each counted in ReadReport;
 // - otherwise vertex order is kept, so per-vertex data in the file stays aligned.
+// Comment lines become Mesh::comments (their text after the marker, blanks trimmed): PLY
+// `comment` header lines, OBJ lines starting with '#', and OFF '#' comments before the element
+// counts and between records (a '#' after a record's values on its line is skipped unread).
+// Only the first kMaxCommentLines are kept, each cut to kMaxCommentBytes and with control
+// characters replaced by '?', so a file of a million comment lines costs no more memory than
+// 256; empty comments and the writers' own stamp ("written by vertexflow") are dropped. STL
+// has no comments: its `solid NAME` names the solid, and the 80-byte binary header is free bytes
+// that many writers fill with binary data; neither is read.
 // Common real-world forms are read: OBJ lines continued with a trailing backslash, OFF counts
 // on the keyword's line, ASCII PLY lines with more values than declared (the extra ones are
 // ignored and counted in ReadReport).
@@ -26,6 +34,7 @@
 
 #include "vertexflow/mesh.h"
 
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <stdexcept>
@@ -42,6 +51,11 @@ class IoError : public std::runtime_error {
 };
 
 enum class MeshFormat { Obj, Ply, Off, Stl };
+
+/// Most comment lines a reader keeps (the first ones; the rest are skipped).
+inline constexpr std::size_t kMaxCommentLines = 256;
+/// Most bytes of one comment line a reader keeps (the rest of the line is skipped).
+inline constexpr std::size_t kMaxCommentBytes = 1024;
 
 /// "OBJ", "PLY", "OFF" or "STL".
 const char* format_name(MeshFormat format);
@@ -122,7 +136,10 @@ struct WriteOptions {
   bool write_vertex_properties = true;
 };
 
-/// Writes a mesh, format chosen by extension (".gz" compresses). The file is written to a
+/// Writes a mesh, format chosen by extension (".gz" compresses). Mesh::comments are written
+/// after the writer's stamp, one per line, as PLY `comment` lines, OBJ `#` lines and, in ASCII
+/// OFF, `#` lines after the keyword line (binary OFF, whose header is one line, and STL carry
+/// none); control characters in them become '?'. The file is written to a
 /// temporary file in the same directory and renamed into place, so `path` is either left as it
 /// was or holds the complete new mesh. Throws IoError.
 ///

@@ -57,6 +57,11 @@ struct Mesh {
   Colors colors;
   /// Optional per-vertex scalar properties, written to PLY as `property double NAME`.
   std::vector<VertexProperty> vertex_properties;
+  /// Free-text comment lines, in file order, without the comment marker: PLY `comment` lines,
+  /// OBJ and OFF `#` lines (io.h says which, and how many are kept). `vertexflow enhance` keeps
+  /// its input's and adds one recording how the vertices were placed (provenance.h). Each is
+  /// one line: writers replace control characters (a newline would end the comment early).
+  std::vector<std::string> comments;
 
   [[nodiscard]] Index num_vertices() const { return static_cast<Index>(V.rows()); }
   [[nodiscard]] Index num_faces() const { return static_cast<Index>(F.rows()); }

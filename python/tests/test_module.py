@@ -85,6 +85,36 @@ def test_smooth_mode_holds_decimated_input_unless_told():
         vertexflow.enhance(Vq, Fq, assume_on_surface=True)
 
 
+def test_comments_round_trip_and_smooth_mode_holds_what_its_provenance_says_is_fitted(tmp_path):
+    # A file written by `vertexflow enhance --surface smooth` records the fit; read with its
+    # comments, the module's smooth mode holds it as the CLI does, unless assume_on_surface.
+    first = tmp_path / "first.ply"
+    run_cli("--quiet", "enhance", DATA / "bunny_adaptive.off", first, "--surface", "smooth")
+    V, F = vertexflow.read_mesh(first)
+    V1, F1, comments = vertexflow.read_mesh(first, comments=True)
+    assert np.array_equal(V, V1) and np.array_equal(F, F1)
+    assert comments[-1] == "vertexflow enhance --surface smooth"
+    held, report = vertexflow.enhance(V, F, surface="smooth", provenance=comments)
+    assert np.array_equal(held, V)
+    assert report["fit"]["held_as_fitted"] and report["fit"]["fitted_by"] == comments[-1]
+    assert report["provenance"] == "vertexflow enhance --surface smooth (held: already fitted)"
+    fitted, report = vertexflow.enhance(V, F, surface="smooth", provenance=comments, assume_on_surface=True)
+    assert not report["fit"]["held_as_fitted"] and not np.array_equal(fitted, V)
+    assert report["provenance"] == "vertexflow enhance --surface smooth --assume-on-surface"
+    # The paper's flow keeps the vertices on the input surface: its line is no fit.
+    flowed, report = vertexflow.enhance(V, F, provenance=["vertexflow enhance --surface input"], surface="smooth")
+    assert not report["fit"]["held_as_fitted"] and not np.array_equal(flowed, V)
+    with pytest.raises(ValueError, match="provenance"):
+        vertexflow.enhance(V, F, surface="smooth", provenance="vertexflow enhance --surface smooth")
+    # write_mesh writes comments; the CLI reads them back and holds the file.
+    out = tmp_path / "fitted.obj"
+    vertexflow.write_mesh(out, fitted, F, comments=comments + [report["provenance"]])
+    assert vertexflow.read_mesh(out, comments=True)[2] == comments + [report["provenance"]]
+    again = tmp_path / "again.ply"
+    run_cli("--quiet", "enhance", out, again, "--surface", "smooth")
+    assert np.array_equal(vertexflow.read_mesh(again)[0], vertexflow.read_mesh(out)[0])
+
+
 def test_thread_count_does_not_change_the_result():
     V, F = read("bunny_uniform.off")
     V1, _ = vertexflow.enhance(V, F, threads=1)

@@ -157,8 +157,10 @@ FitResult fit_to_smooth_surface(const Vertices& V, const Faces& F, const SmoothF
   FitResult result;
   FitReport& report = result.report;
   report.poor_face_fraction = summarize_quality(triangle_quality(V, F)).fraction_below_0_3;
-  if (report.poor_face_fraction > options.max_poor_face_fraction) {
-    report.held_as_decimated = true;
+  if (options.already_fitted || report.poor_face_fraction > options.max_poor_face_fraction) {
+    // One reason: the provenance, when there is one, says more than the triangle shapes.
+    report.held_as_fitted = options.already_fitted;
+    report.held_as_decimated = !options.already_fitted;
     result.V = V;
     return result;
   }

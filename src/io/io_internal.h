@@ -22,6 +22,7 @@ struct PolygonSoup {
   std::vector<std::int64_t> offsets{0};       // polygon p is corners[offsets[p], offsets[p+1])
   std::vector<std::uint8_t> rgb;              // empty or 3 per vertex
   std::vector<VertexProperty> properties;     // per-vertex scalars other than x, y, z, colours
+  std::vector<std::string> comments;          // Mesh::comments, bounded by add_comment
   bool weld_vertices = false;                 // STL: facets carry their own vertex copies
   int index_base = 0;                         // how the file numbers vertices (OBJ: 1), for messages
 
@@ -41,6 +42,14 @@ struct PolygonSoup {
 
 /// Throws IoError("name: message").
 [[noreturn]] void fail(const std::string& name, const std::string& message);
+
+/// Adds the comment whose text (after the marker) starts `line` to `comments`, as io.h says:
+/// cut at the first newline and to kMaxCommentBytes, blanks trimmed, control characters
+/// replaced, empty ones and the writers' stamp dropped, nothing once kMaxCommentLines are kept.
+void add_comment(std::vector<std::string>& comments, std::string_view line);
+
+/// The writers' own first comment, which every write adds and reading drops.
+inline constexpr std::string_view kWriterStamp = "written by vertexflow";
 
 // Parsers: bytes -> soup, pulling from the source only what they read. Each throws IoError
 // naming `name`.
@@ -163,7 +172,8 @@ class TextScanner {
       if (p < n || !fill(pos_ + 1, pos_)) return;
     }
   }
-  /// Skips all whitespace including newlines; with `comments`, also '#' to end of line.
+  /// Skips all whitespace including newlines; with `comments`, also '#' to end of line, and
+  /// hands the text of those comments to the sink set by collect_comments.
   void skip_whitespace(bool comments = false) {
     for (;;) {
       std::size_t p = pos_;
@@ -173,11 +183,19 @@ class TextScanner {
       pos_ = p;
       if (p < n) {
         if (!comments || d[p] != '#') return;
+        if (comment_sink_ != nullptr) take_comment();
         skip_line();
       } else if (!fill(pos_ + 1, pos_)) {
         return;
       }
     }
+  }
+  /// Comments skipped by skip_whitespace(true) are added to `sink` (add_comment); nullptr stops.
+  void collect_comments(std::vector<std::string>* sink) { comment_sink_ = sink; }
+  /// Adds the rest of the current line, after the comment marker at the current position, to
+  /// `sink` (add_comment). Does not move: the caller skips the line as it would otherwise.
+  void peek_comment(std::vector<std::string>& sink) {
+    if (sink.size() < kMaxCommentLines) add_comment(sink, lookahead(kMaxCommentBytes + 2).substr(1));
   }
   /// Moves past the next '\n' (or to the end).
   void skip_line() {
@@ -286,6 +304,8 @@ class TextScanner {
     return text_.substr(std::min(start, text_.size()), pos_ - start);
   }
 
+  [[gnu::noinline, gnu::cold]] void take_comment() { peek_comment(*comment_sink_); }
+
   // Asks the source for bytes up to view index `end`, letting it drop those before view index
   // `keep`; refreshes the view, which may have moved, and the index of the current position.
   [[gnu::noinline, gnu::cold]] bool fill(std::size_t end, std::size_t keep) {
@@ -304,6 +324,7 @@ class TextScanner {
   const std::string& name_;
   std::size_t pos_ = 0;  // index into text_
   std::uint64_t lines_back_ = 0;
+  std::vector<std::string>* comment_sink_ = nullptr;
 };
 
 }  // namespace vertexflow::io_detail

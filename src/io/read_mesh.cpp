@@ -40,6 +40,20 @@ void TextScanner::error(const std::string& message) const {
   fail(name_, fmt::format("line {}: {}", line - std::min(lines_back_, line - 1), message));
 }
 
+void add_comment(std::vector<std::string>& comments, std::string_view line) {
+  if (comments.size() >= kMaxCommentLines) return;
+  line = line.substr(0, line.find('\n'));
+  const auto blank = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\f' || c == '\v'; };
+  while (!line.empty() && blank(line.front())) line.remove_prefix(1);
+  line = line.substr(0, kMaxCommentBytes);
+  while (!line.empty() && blank(line.back())) line.remove_suffix(1);
+  if (line.empty() || line == kWriterStamp) return;
+  std::string& text = comments.emplace_back(line);
+  for (char& c : text) {
+    if (static_cast<unsigned char>(c) < 32 || c == 127) c = '?';
+  }
+}
+
 std::string TextScanner::printable(std::string_view tok) {
   std::string out;
   for (const char c : tok.substr(0, 40)) {
@@ -315,6 +329,7 @@ Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& repor
 
   if (!soup.rgb.empty()) mesh.colors = Eigen::Map<const Colors>(soup.rgb.data(), nv, 3);
   mesh.vertex_properties = std::move(soup.properties);
+  mesh.comments = std::move(soup.comments);
 
   // Remove unreferenced vertices, keeping the order of the others.
   std::vector<Index> new_index(static_cast<std::size_t>(nv), -1);

@@ -1,5 +1,6 @@
-// Wavefront OBJ reader: `v` positions and `f` faces (v, v/t, v//n, v/t/n, negative indices);
-// every other statement (vt, vn, g, o, s, usemtl, mtllib, l, p, ...) is skipped.
+// Wavefront OBJ reader: `v` positions and `f` faces (v, v/t, v//n, v/t/n, negative indices),
+// and '#' comments (io.h); every other statement (vt, vn, g, o, s, usemtl, mtllib, l, p, ...)
+// is skipped.
 //
 // A line whose last character other than blanks is a backslash continues on the next line, as
 // the OBJ specification allows (a long `f` statement split over lines). This holds for every
@@ -117,6 +118,9 @@ PolygonSoup parse_obj(ByteSource& source, const std::string& name) {
         continue;
       }
     } else {
+      // A comment's first line (a continued one's further lines are skipped with it).
+      if (in.peek() == '#') [[unlikely]]
+        in.peek_comment(soup.comments);
       statement.end();
       continue;
     }

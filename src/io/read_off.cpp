@@ -119,6 +119,8 @@ PolygonSoup parse_binary(std::string_view bytes, std::size_t start, const OffHea
 
 PolygonSoup parse_off(ByteSource& source, const std::string& name, ReadReport& report) {
   TextScanner in(source, name);
+  std::vector<std::string> comments;
+  in.collect_comments(&comments);
   const OffHeader keyword = parse_keyword(in.token(/*comments=*/true), name);
   OffHeader h = keyword;
   // "OFF BINARY" on the first line switches to the binary layout after that line.
@@ -130,7 +132,9 @@ PolygonSoup parse_off(ByteSource& source, const std::string& name, ReadReport& r
     report.binary = true;
     // The layout is chosen by which one reads the whole file exactly, so it needs the size.
     source.request_all();
-    return parse_binary(source.data(), in.position() - source.offset(), h, name);
+    PolygonSoup soup = parse_binary(source.data(), in.position() - source.offset(), h, name);
+    soup.comments = std::move(comments);
+    return soup;
   }
   const std::int64_t nv = in.next_int("the vertex count", true);
   const std::int64_t nf = in.next_int("the face count", true);
@@ -139,6 +143,8 @@ PolygonSoup parse_off(ByteSource& source, const std::string& name, ReadReport& r
   // Shortest records: "0 0 0\n" for a vertex, "3 0 1 2\n" for a face.
   check_counts(nv, nf, in.remaining_bound(), 6, 8, name);
   PolygonSoup soup;
+  soup.comments = std::move(comments);
+  in.collect_comments(&soup.comments);
   soup.xyz.reserve(3 * static_cast<std::size_t>(nv));  // resident only as vertices fill it (read_ply.cpp)
   for (std::int64_t v = 0; v < nv; ++v) {
     const double x = in.next_double("a vertex coordinate", true);

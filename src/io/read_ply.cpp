@@ -102,7 +102,9 @@ class PlyParser {
     bool have_format = false;
     while (!header.at_end()) {
       const std::string_view keyword = header.token_on_line();
-      if (keyword.empty() || keyword == "comment" || keyword == "obj_info") {
+      if (keyword == "comment") {
+        add_comment(soup_.comments, header.lookahead(kMaxCommentBytes + 1));
+      } else if (keyword.empty() || keyword == "obj_info") {
       } else if (keyword == "format") {
         const std::string_view format = header.token_on_line();
         if (format == "ascii") encoding_ = Encoding::Ascii;

@@ -312,6 +312,16 @@ void append_face(std::string& b, const char* prefix, const Mesh& mesh, Index f, 
   b += '\n';
 }
 
+// PREFIX + each comment + "\n". A control character would end the line (a newline in a PLY
+// comment could even write "end_header"), so each becomes '?', as reading does.
+void append_comments(std::string& b, std::string_view prefix, const Mesh& mesh) {
+  for (const std::string& comment : mesh.comments) {
+    b += prefix;
+    for (const char c : comment) b += static_cast<unsigned char>(c) < 32 || c == 127 ? '?' : c;
+    b += '\n';
+  }
+}
+
 bool has_colors(const Mesh& mesh, const WriteOptions& options) {
   return options.write_colors && mesh.colors.rows() == mesh.V.rows() && mesh.colors.rows() > 0;
 }
@@ -319,6 +329,7 @@ bool has_colors(const Mesh& mesh, const WriteOptions& options) {
 void write_obj(Output& out, const Mesh& mesh) {
   std::string& b = out.buffer();
   b += "# written by vertexflow\n";
+  append_comments(b, "# ", mesh);
   for (Index v = 0; v < mesh.num_vertices(); ++v) {
     append_position(b, "v ", mesh, v);
     b += '\n';
@@ -356,6 +367,8 @@ void write_off(Output& out, const Mesh& mesh, const WriteOptions& options) {
     return;
   }
   b += colors ? "COFF\n" : "OFF\n";
+  // After the keyword line, which many readers (PMP's) expect first.
+  append_comments(b, "# ", mesh);
   b += fmt::format("{} {} 0\n", mesh.num_vertices(), mesh.num_faces());
   for (Index v = 0; v < mesh.num_vertices(); ++v) {
     append_position(b, "", mesh, v);
@@ -387,6 +400,7 @@ void write_ply(Output& out, const std::string& name, const Mesh& mesh, const Wri
        : options.ply_encoding == PlyEncoding::BinaryBigEndian ? "binary_big_endian"
                                                               : "binary_little_endian";
   b += " 1.0\ncomment written by vertexflow\n";
+  append_comments(b, "comment ", mesh);
   b += fmt::format("element vertex {}\nproperty {} x\nproperty {} y\nproperty {} z\n", mesh.num_vertices(), coordinate,
                    coordinate, coordinate);
   if (colors) b += "property uchar red\nproperty uchar green\nproperty uchar blue\n";

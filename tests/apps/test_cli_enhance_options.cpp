@@ -304,6 +304,85 @@ TEST(CliEnhanceOptions, SmoothSurfaceFitsTheEstimate) {
   EXPECT_EQ(quiet.err.find("decimated"), std::string::npos) << quiet.err;
 }
 
+// The line of stderr that holds `what` (empty if none).
+std::string line_with(const std::string& text, const std::string& what) {
+  const std::size_t at = text.find(what);
+  if (at == std::string::npos) return {};
+  const std::size_t begin = text.rfind('\n', at) == std::string::npos ? 0 : text.rfind('\n', at) + 1;
+  return text.substr(begin, text.find('\n', at) - begin);
+}
+
+// Provenance (provenance.h): each run adds a line to the output's comments, after the input's;
+// smooth mode on its own output holds it unchanged, with a one-line warning naming the file, the
+// reason and the override, and the hold in the report; --assume-on-surface fits anyway. The
+// paper's flow keeps the vertices on the input surface, so its output is fitted as usual.
+TEST(CliEnhanceOptions, SmoothModeHoldsAnInputItsProvenanceSaysIsFitted) {
+  test::ScratchDir dir("cli-enhance-provenance");
+  const auto first = dir.file("first.ply"), second = dir.file("second.ply"), assumed = dir.file("assumed.ply"),
+             flowed = dir.file("flowed.ply"), after_flow = dir.file("after_flow.ply"), report = dir.file("report.json");
+  const Mesh input = read_mesh(test::data_path("bunny_adaptive.off"));
+  const auto r1 = test::run_cli("--quiet enhance " + test::quoted_data_path("bunny_adaptive.off") + " " +
+                                test::quoted(first) + " --surface smooth");
+  ASSERT_EQ(r1.exit_code, 0) << r1.err;
+  const Mesh fitted = read_mesh(first);
+  ASSERT_NE(fitted.V, input.V);
+  std::vector<std::string> expected = input.comments;
+  expected.push_back("vertexflow enhance --surface smooth");
+  EXPECT_EQ(fitted.comments, expected);
+
+  const auto r2 = test::run_cli("enhance " + test::quoted(first) + " " + test::quoted(second) +
+                                " --surface smooth --report " + test::quoted(report));
+  ASSERT_EQ(r2.exit_code, 0) << r2.err;
+  const std::string warning = line_with(r2.err, "warning:");
+  EXPECT_NE(warning.find("first.ply: "), std::string::npos) << r2.err;
+  EXPECT_NE(warning.find("'vertexflow enhance --surface smooth' records an earlier fit"), std::string::npos) << r2.err;
+  EXPECT_NE(warning.find("held every vertex"), std::string::npos) << r2.err;
+  EXPECT_NE(warning.find("--assume-on-surface fits anyway"), std::string::npos) << r2.err;
+  EXPECT_TRUE(line_with(r2.err, "decimated").empty()) << r2.err;
+  const Mesh held = read_mesh(second);
+  EXPECT_EQ(held.V, fitted.V);
+  EXPECT_EQ(held.F, fitted.F);
+  expected.push_back("vertexflow enhance --surface smooth (held: already fitted)");
+  EXPECT_EQ(held.comments, expected);
+  const nlohmann::json j = nlohmann::json::parse(test::read_text(report));
+  EXPECT_TRUE(j["fit"]["held_as_fitted"]);
+  EXPECT_FALSE(j["fit"]["held_as_decimated"]);
+  EXPECT_EQ(j["fit"]["fitted_by"], "vertexflow enhance --surface smooth");
+  EXPECT_EQ(j["provenance"], "vertexflow enhance --surface smooth (held: already fitted)");
+  // A held run records no fit of its own, but the chain still holds the first one.
+  const auto r2b = test::run_cli("--quiet enhance " + test::quoted(second) + " " + test::quoted(assumed) +
+                                 " --surface smooth --report " + test::quoted(report));
+  ASSERT_EQ(r2b.exit_code, 0) << r2b.err;
+  EXPECT_EQ(read_mesh(assumed).V, fitted.V);
+
+  const auto r3 = test::run_cli("--quiet enhance " + test::quoted(first) + " " + test::quoted(assumed) +
+                                " --surface smooth --assume-on-surface --report " + test::quoted(report));
+  ASSERT_EQ(r3.exit_code, 0) << r3.err;
+  const Mesh again = read_mesh(assumed);
+  EXPECT_NE(again.V, fitted.V);
+  EXPECT_EQ(again.comments.back(), "vertexflow enhance --surface smooth --assume-on-surface");
+  EXPECT_FALSE(nlohmann::json::parse(test::read_text(report))["fit"]["held_as_fitted"]);
+
+  const auto r4 = test::run_cli("--quiet enhance " + test::quoted_data_path("bunny_adaptive.off") + " " +
+                                test::quoted(flowed) + " --surface input");
+  ASSERT_EQ(r4.exit_code, 0) << r4.err;
+  EXPECT_EQ(read_mesh(flowed).comments.back(), "vertexflow enhance --surface input");
+  const auto r5 = test::run_cli("enhance " + test::quoted(flowed) + " " + test::quoted(after_flow) +
+                                " --surface smooth --report " + test::quoted(report));
+  ASSERT_EQ(r5.exit_code, 0) << r5.err;
+  EXPECT_TRUE(line_with(r5.err, "warning:").empty()) << r5.err;
+  EXPECT_NE(read_mesh(after_flow).V, read_mesh(flowed).V);
+  EXPECT_FALSE(nlohmann::json::parse(test::read_text(report))["fit"]["held_as_fitted"]);
+
+  // STL keeps no comments: writing a fit to it says the provenance is lost.
+  const auto stl = test::run_cli("enhance " + test::quoted_data_path("sphere_low.off") + " " +
+                                 test::quoted(dir.file("fit.stl")) + " --surface smooth");
+  ASSERT_EQ(stl.exit_code, 0) << stl.err;
+  EXPECT_NE(line_with(stl.err, "fit.stl: STL keeps no comments").find("a later --surface smooth run"),
+            std::string::npos)
+      << stl.err;
+}
+
 TEST(CliEnhanceOptions, NoProjectionLeavesTheSurface) {
   // Without the projection the vertices stay where the solve put them, off the input surface;
   // projected, they lie on it (fandisk: flat facets, so on the facets themselves).

@@ -1,7 +1,8 @@
 // Smooth mode (fit.h): the PN-triangle estimate interpolates the vertices, keeps creases
 // straight and is close to a sphere through them; the fit to it moves an inscribed sphere out
 // towards the sphere and brings bunny_uniform closer to the dense bunny (issue 16's bar), leaves
-// a mesh of planar faces and creases where it is, holds decimated input, and is invariant and
+// a mesh of planar faces and creases where it is, holds decimated input and input whose
+// provenance records a fit (and the provenance lines themselves), and is invariant and
 // deterministic.
 #include "shapes.h"
 #include "test_support.h"
@@ -9,6 +10,7 @@
 #include "vertexflow/distance.h"
 #include "vertexflow/fit.h"
 #include "vertexflow/io.h"
+#include "vertexflow/provenance.h"
 #include "vertexflow/simplify.h"
 
 #include <gtest/gtest.h>
@@ -147,6 +149,75 @@ TEST(SmoothFit, InvariantAndDeterministic) {
   std::cout << "[measured] smooth torus: moved " << moved << ", transformed difference " << difference << "\n";
   EXPECT_GT(moved, 1e-3);
   EXPECT_LE(difference, 1e-6);
+}
+
+// A previous fit, known from the input's provenance (provenance.h), is held before the quality
+// test; fitted anyway, a second run moves the mesh further out, which is why it is held.
+TEST(SmoothFit, InputKnownToBeFittedIsHeldAndWouldOvershoot) {
+  const Mesh dense = read_mesh(test::data_path("bunny.off"));
+  const Mesh input = read_mesh(test::data_path("bunny_adaptive.off"));
+  const FitResult first = fit_to_smooth_surface(input.V, input.F);
+  ASSERT_FALSE(first.report.held_as_decimated);
+  SmoothFitOptions fitted;
+  fitted.already_fitted = true;
+  const FitResult held = fit_to_smooth_surface(first.V, input.F, fitted);
+  EXPECT_TRUE(held.report.held_as_fitted);
+  EXPECT_FALSE(held.report.held_as_decimated);
+  EXPECT_EQ(held.V, first.V);
+  const FitResult second = fit_to_smooth_surface(first.V, input.F);
+  EXPECT_FALSE(second.report.held_as_fitted);
+  const double in = mean_two_sided(input.V, input.F, dense), once = mean_two_sided(first.V, input.F, dense),
+               twice = mean_two_sided(second.V, input.F, dense);
+  std::cout << "[measured] smooth on bunny_adaptive: first run " << once / in - 1 << ", second run, not held "
+            << twice / once - 1 << " on the first's\n";
+  EXPECT_LT(once, 0.85 * in);    // measured -30%
+  EXPECT_GT(twice, 1.2 * once);  // measured +37%
+}
+
+TEST(Provenance, LinesAndWhichOfThemRecordAFit) {
+  ProvenanceRun run;
+  EXPECT_EQ(provenance_line(run), "vertexflow enhance --surface input");
+  run.edge_flips = true;
+  EXPECT_EQ(provenance_line(run), "vertexflow enhance --surface input --edge-flips");
+  EXPECT_FALSE(records_fit(provenance_line(run)));
+  run = {};
+  run.mode = EnhanceMode::Smooth;
+  EXPECT_EQ(provenance_line(run), "vertexflow enhance --surface smooth");
+  EXPECT_TRUE(records_fit(provenance_line(run)));
+  run.assume_on_surface = true;
+  EXPECT_TRUE(records_fit(provenance_line(run)));
+  run.held = "already fitted";
+  EXPECT_EQ(provenance_line(run), "vertexflow enhance --surface smooth --assume-on-surface (held: already fitted)");
+  EXPECT_FALSE(records_fit(provenance_line(run)));
+  run = {};
+  run.mode = EnhanceMode::ReferenceFit;
+  run.reference = "/some dir/dense mesh.ply";
+  EXPECT_EQ(provenance_line(run), "vertexflow enhance --reference dense?mesh.ply --reference-method fit");
+  EXPECT_TRUE(records_fit(provenance_line(run)));
+  run.mode = EnhanceMode::ReferenceFlow;
+  EXPECT_EQ(provenance_line(run), "vertexflow enhance --reference dense?mesh.ply --reference-method flow");
+  EXPECT_FALSE(records_fit(provenance_line(run)));
+  run = {};
+  run.mode = EnhanceMode::Unsharp;
+  EXPECT_EQ(provenance_line(run), "vertexflow enhance --method unsharp");
+  EXPECT_FALSE(records_fit(provenance_line(run)));
+  for (const char* other : {"", "vertexflow", "written by vertexflow", "made with --surface smooth",
+                            "vertexflow enhance --surface", "vertexflow remesh --surface smooth"})
+    EXPECT_FALSE(records_fit(other)) << other;
+  const std::vector<std::string> chain = {"scan", "vertexflow enhance --surface input",
+                                          "vertexflow enhance --surface smooth", "vertexflow enhance --surface input"};
+  ASSERT_NE(find_fit_provenance(chain), nullptr);
+  EXPECT_EQ(find_fit_provenance(chain), &chain[2]);
+  EXPECT_EQ(find_fit_provenance({"scan"}), nullptr);
+}
+
+// However long the chain, the comments stay within what a reader keeps, and a fit stays.
+TEST(Provenance, AppendingKeepsTheBoundAndTheFit) {
+  std::vector<std::string> comments = {"scan", "vertexflow enhance --surface smooth"};
+  for (int i = 0; i < 1000; ++i) append_provenance(comments, "vertexflow enhance --surface input");
+  EXPECT_EQ(comments.size(), kMaxCommentLines);
+  ASSERT_NE(find_fit_provenance(comments), nullptr);
+  EXPECT_EQ(comments.back(), "vertexflow enhance --surface input");
 }
 
 }  // namespace
