@@ -18,6 +18,8 @@
 #include "vertexflow/fit.h"
 #include "vertexflow/flow.h"
 #include "vertexflow/io.h"
+#include "vertexflow/line_drawing.h"
+#include "vertexflow/lines.h"
 #include "vertexflow/provenance.h"
 #include "vertexflow/remesh.h"
 #include "vertexflow/render.h"
@@ -617,6 +619,122 @@ py::array py_render(const py::handle& V, const py::handle& F, int width, int hei
   return rgb;
 }
 
+// Line options from keyword values (lines.h); the same names as the CLI's, with underscores.
+LineOptions line_options(bool contours, bool suggestive_contours, bool ridges, bool valleys,
+                         double suggestive_threshold, double ridge_threshold, double smoothing_scale,
+                         double length_scale) {
+  LineOptions o;
+  o.contours = contours;
+  o.suggestive_contours = suggestive_contours;
+  o.ridges = ridges;
+  o.valleys = valleys;
+  o.suggestive_threshold = suggestive_threshold;
+  o.ridge_threshold = ridge_threshold;
+  o.smoothing_scale = smoothing_scale;
+  o.length_scale = length_scale;
+  return o;
+}
+
+py::array_t<double> points_array(const std::vector<Eigen::Vector2d>& points) {
+  py::array_t<double> out({static_cast<py::ssize_t>(points.size()), static_cast<py::ssize_t>(2)});
+  double* data = out.mutable_data();
+  for (std::size_t i = 0; i < points.size(); ++i) data[2 * i] = points[i].x(), data[2 * i + 1] = points[i].y();
+  return out;
+}
+
+py::list py_feature_lines(const py::handle& V, const py::handle& F, const py::object& direction, const py::object& eye,
+                          bool contours, bool suggestive_contours, bool ridges, bool valleys,
+                          double suggestive_threshold, double ridge_threshold, double smoothing_scale,
+                          double length_scale, int threads) {
+  MeshArgs args = mesh_args(V, F);
+  if (!direction.is_none() && !eye.is_none())
+    throw std::invalid_argument("feature_lines: give direction (orthographic) or eye (perspective), not both");
+  View view;
+  view.orthographic = eye.is_none();
+  const auto vec3 = [](const py::object& o, const char* name) {
+    const std::vector<double> v = o.cast<std::vector<double>>();
+    if (v.size() != 3) throw std::invalid_argument(std::string("feature_lines: ") + name + " needs 3 values");
+    return Eigen::Vector3d(v[0], v[1], v[2]);
+  };
+  if (!direction.is_none()) view.direction = vec3(direction, "direction");
+  if (!eye.is_none()) view.eye = vec3(eye, "eye");
+  const LineOptions options = line_options(contours, suggestive_contours, ridges, valleys, suggestive_threshold,
+                                           ridge_threshold, smoothing_scale, length_scale);
+  const std::vector<Polyline> lines =
+      without_gil(threads, [&] { return feature_lines(args.V, args.F, view, options); });
+  py::list out;
+  for (const Polyline& line : lines) {
+    py::array_t<double> points({static_cast<py::ssize_t>(line.points.rows()), static_cast<py::ssize_t>(3)});
+    std::memcpy(points.mutable_data(), line.points.data(), sizeof(double) * 3 * line.points.rows());
+    out.append(py::dict(py::arg("type") = std::string(line_type_name(line.type)), py::arg("points") = points,
+                        py::arg("closed") = line.closed));
+  }
+  return out;
+}
+
+LineDrawingOptions drawing_options(int width, int height, const std::string& view, double azimuth, double elevation,
+                                   const LineOptions& lines, bool hidden_line_removal) {
+  LineDrawingOptions o;
+  o.render.width = width;
+  o.render.height = height;
+  o.render.view = enum_option<RenderView>("view", py::str(view),
+                                          {{"front", RenderView::Front},
+                                           {"side", RenderView::Side},
+                                           {"top", RenderView::Top},
+                                           {"iso", RenderView::Iso},
+                                           {"custom", RenderView::Custom}});
+  o.render.azimuth_degrees = azimuth;
+  o.render.elevation_degrees = elevation;
+  o.lines = lines;
+  o.hidden_line_removal = hidden_line_removal;
+  return o;
+}
+
+py::dict py_line_drawing(const py::handle& V, const py::handle& F, int width, int height, const std::string& view,
+                         double azimuth, double elevation, bool contours, bool suggestive_contours, bool ridges,
+                         bool valleys, double suggestive_threshold, double ridge_threshold, double smoothing_scale,
+                         double length_scale, bool hidden_line_removal, double line_width, int threads) {
+  MeshArgs args = mesh_args(V, F);
+  Mesh mesh;
+  mesh.V = std::move(args.V);
+  mesh.F = std::move(args.F);
+  const LineDrawingOptions options =
+      drawing_options(width, height, view, azimuth, elevation,
+                      line_options(contours, suggestive_contours, ridges, valleys, suggestive_threshold,
+                                   ridge_threshold, smoothing_scale, length_scale),
+                      hidden_line_removal);
+  const LineDrawing drawing = without_gil(threads, [&] { return draw_lines(mesh, options); });
+  py::list lines;
+  for (const ImagePolyline& line : drawing.lines)
+    lines.append(py::dict(py::arg("type") = std::string(line_type_name(line.type)),
+                          py::arg("points") = points_array(line.points)));
+  return py::dict(py::arg("lines") = lines, py::arg("svg") = svg_document(drawing, line_width),
+                  py::arg("width") = drawing.width, py::arg("height") = drawing.height);
+}
+
+py::dict py_compare_lines(const py::handle& Vc, const py::handle& Fc, const py::handle& Vd, const py::handle& Fd,
+                          int views, double elevation, int width, int height, double match_pixels, int threads) {
+  MeshArgs coarse_args = mesh_args(Vc, Fc, "V_coarse", "F_coarse"),
+           dense_args = mesh_args(Vd, Fd, "V_dense", "F_dense");
+  Mesh coarse, dense;
+  coarse.V = std::move(coarse_args.V), coarse.F = std::move(coarse_args.F);
+  dense.V = std::move(dense_args.V), dense.F = std::move(dense_args.F);
+  LineFidelityOptions options;
+  options.views = views;
+  options.elevation_degrees = elevation;
+  options.width = width;
+  options.height = height;
+  options.match_pixels = match_pixels;
+  const LineFidelity fidelity = without_gil(threads, [&] { return line_drawing_fidelity(coarse, dense, options); });
+  py::list per_view;
+  for (const LineFidelityView& v : fidelity.views)
+    per_view.append(py::dict(py::arg("azimuth") = v.azimuth_degrees, py::arg("precision") = v.precision,
+                             py::arg("recall") = v.recall, py::arg("f1") = v.f1,
+                             py::arg("coarse_pixels") = v.coarse_pixels, py::arg("dense_pixels") = v.dense_pixels));
+  return py::dict(py::arg("precision") = fidelity.precision, py::arg("recall") = fidelity.recall,
+                  py::arg("f1") = fidelity.f1, py::arg("views") = per_view);
+}
+
 cli::BatchFileOptions batch_file_options(py::dict& rest, const py::kwargs& kwargs) {
   cli::BatchFileOptions options;
   rest = take_flow_options(kwargs, options.flow);
@@ -809,6 +927,28 @@ view: front, side, top, iso, custom (azimuth, elevation); color: none, mean, gau
 displacement (needs displacement_reference, the positions before); shading: smooth, flat,
 exaggerated (Rusinkiewicz et al. 2006, render.h's default options).
 threads limits the TBB part; llvmpipe rasterises with LP_NUM_THREADS threads.)doc");
+  m.def("feature_lines", &py_feature_lines, py::arg("V"), py::arg("F"), py::kw_only(),
+        py::arg("direction") = py::none(), py::arg("eye") = py::none(), py::arg("contours") = true,
+        py::arg("suggestive_contours") = true, py::arg("ridges") = true, py::arg("valleys") = true,
+        py::arg("suggestive_threshold") = 20.0, py::arg("ridge_threshold") = 25.0, py::arg("smoothing_scale") = 0.0,
+        py::arg("length_scale") = 0.0, py::arg("threads") = 0,
+        R"doc(The feature lines as 3D polylines (lines.h) -> [{"type", "points" (N, 3), "closed"}].
+Orthographic along direction (default (0, 0, -1)) or perspective from eye. type is contours,
+suggestive-contours, ridges or valleys; thresholds in units of L (length_scale, default the
+bounding-box diagonal). Hidden lines are not removed: line_drawing does that.)doc");
+  m.def("line_drawing", &py_line_drawing, py::arg("V"), py::arg("F"), py::kw_only(), py::arg("width") = 800,
+        py::arg("height") = 600, py::arg("view") = "iso", py::arg("azimuth") = 30.0, py::arg("elevation") = 20.0,
+        py::arg("contours") = true, py::arg("suggestive_contours") = true, py::arg("ridges") = true,
+        py::arg("valleys") = true, py::arg("suggestive_threshold") = 20.0, py::arg("ridge_threshold") = 25.0,
+        py::arg("smoothing_scale") = 0.0, py::arg("length_scale") = 0.0, py::arg("hidden_line_removal") = true,
+        py::arg("line_width") = 1.5, py::arg("threads") = 0,
+        R"doc(`vertexflow lines` in memory (line_drawing.h) -> {"lines": [{"type", "points" (N, 2) pixels}],
+"svg": str, "width", "height"}: render's camera, hidden lines removed with its depth buffer.)doc");
+  m.def("compare_lines", &py_compare_lines, py::arg("V_coarse"), py::arg("F_coarse"), py::arg("V_dense"),
+        py::arg("F_dense"), py::kw_only(), py::arg("views") = 8, py::arg("elevation") = 15.0, py::arg("width") = 800,
+        py::arg("height") = 600, py::arg("match_pixels") = 2.0, py::arg("threads") = 0,
+        R"doc(`vertexflow compare-lines`: line-drawing fidelity of the coarse mesh against the dense one
+(line_drawing.h) -> {"precision", "recall", "f1", "views": [per view]}.)doc");
   m.def("enhance_file", &py_enhance_file, py::arg("input"), py::arg("output"),
         R"doc(enhance_file(input, output, *, force=False, metrics=True, threads=0, **flow options) -> dict
 

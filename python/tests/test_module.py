@@ -274,6 +274,27 @@ def test_compare_simplify_remesh_render():
 # --- the GIL ---------------------------------------------------------------------------------------
 
 
+def test_feature_lines_line_drawing_and_compare_lines():
+    V, F = read("sphere.off")  # the unit sphere
+    # Orthographic along -z: the contour is the great circle z = 0, radius 1 (chords of the edges).
+    lines = vertexflow.feature_lines(V, F, suggestive_contours=False, ridges=False, valleys=False)
+    assert [line["type"] for line in lines] == ["contours"] and lines[0]["closed"]
+    points = lines[0]["points"]
+    assert points.shape[1] == 3 and len(points) > 50
+    assert np.abs(points[:, 2]).max() < 0.05
+    assert np.abs(np.linalg.norm(points, axis=1) - 1).max() < 0.02
+    with pytest.raises(ValueError):
+        vertexflow.feature_lines(V, F, direction=(0, 0, -1), eye=(0, 0, 5))
+    drawing = vertexflow.line_drawing(*read("bunny_uniform.off"), width=400, height=300)
+    assert drawing["svg"].startswith("<?xml") and '<g id="ridges"' in drawing["svg"]
+    assert {line["type"] for line in drawing["lines"]} == {"contours", "suggestive-contours", "ridges", "valleys"}
+    assert all(line["points"].shape[1] == 2 for line in drawing["lines"])
+    same = vertexflow.compare_lines(V, F, V, F, views=6, width=200, height=150)
+    assert same["f1"] == 1.0 and len(same["views"]) == 6
+    moved = V + np.array([0.1, 0, 0])
+    assert vertexflow.compare_lines(moved, F, V, F, views=6, width=200, height=150)["f1"] < 0.6
+
+
 def test_gil_is_released_during_enhance():
     # The progress callback is called just before the C++ work and just after it. Released, the
     # GIL lets this thread run at once; held, this thread gets it back only when the call ends.

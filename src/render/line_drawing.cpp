@@ -277,11 +277,14 @@ LineFidelity line_drawing_fidelity(const Mesh& coarse, const Mesh& dense, const 
     view.recall = matched_share(b, a, options.width, options.height, options.match_pixels, view.dense_pixels);
     const double sum = view.precision + view.recall;
     view.f1 = sum > 0 ? 2 * view.precision * view.recall / sum : 0.0;
-    result.precision += view.precision / options.views;
-    result.recall += view.recall / options.views;
-    result.f1 += view.f1 / options.views;
+    result.precision += view.precision;  // sums here, means after the loop
+    result.recall += view.recall;
+    result.f1 += view.f1;
     result.views.push_back(view);
   }
+  result.precision /= options.views;
+  result.recall /= options.views;
+  result.f1 /= options.views;
   return result;
 }
 
