@@ -35,8 +35,8 @@ void check_counts(std::int64_t nv, std::int64_t nf, std::uint64_t available, std
   if (nv < 0 || nf < 0) fail(name, fmt::format("negative element count in header ({} vertices, {} faces)", nv, nf));
   const auto fits = static_cast<std::uint64_t>(nv) * vertex_bytes + static_cast<std::uint64_t>(nf) * face_bytes;
   if (static_cast<std::uint64_t>(nv) > available || static_cast<std::uint64_t>(nf) > available || fits > available + 1)
-    fail(name, fmt::format("header declares {} vertices and {} faces, but the remaining {} bytes cannot hold them",
-                           nv, nf, available));
+    fail(name, fmt::format("header declares {} vertices and {} faces, but the remaining {} bytes cannot hold them", nv,
+                           nf, available));
 }
 
 // One binary layout: byte order, and whether each face ends with a colour count. The
@@ -53,7 +53,8 @@ PolygonSoup parse_binary(std::string_view bytes, std::size_t start, const OffHea
   const bool swap = layout.big_endian == host_is_little_endian();
   std::size_t pos = start;
   auto need = [&](std::size_t n, const char* what) {
-    if (n > bytes.size() - pos) fail(name, fmt::format("unexpected end of file while reading {} (file truncated?)", what));
+    if (n > bytes.size() - pos)
+      fail(name, fmt::format("unexpected end of file while reading {} (file truncated?)", what));
   };
   need(12, "the element counts");
   const std::int64_t nv = load_scalar<std::int32_t>(bytes.data() + pos, swap);

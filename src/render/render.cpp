@@ -555,8 +555,8 @@ Image render_mesh(const Mesh& mesh, const RenderOptions& options, RenderInfo* in
   Eigen::VectorXd shades;
   if (exaggerated && mesh.F.rows() > 0) {
     const Eigen::Vector3d& l = options.exaggerated_light;  // camera coordinates
-    shades =
-        exaggerated_shading(mesh.V, mesh.F, l.x() * view.right + l.y() * view.up + l.z() * view.back, options.exaggerated);
+    shades = exaggerated_shading(mesh.V, mesh.F, l.x() * view.right + l.y() * view.up + l.z() * view.back,
+                                 options.exaggerated);
   }
   const DrawArrays arrays = build_arrays(mesh, options, field, shades, centre);
   const double prepare_seconds = seconds_since(start);
