@@ -9,39 +9,13 @@
 // lines (the groups removed in the page) has no dark pixel, so the pixels come from the lines.
 // Prints one line per check and "N passed, M failed"; exit 1 on a failure.
 import { execFileSync } from 'node:child_process';
-import { mkdirSync, rmSync } from 'node:fs';
 import path from 'node:path';
 import { pathToFileURL } from 'node:url';
 import { chromium } from 'playwright-core';
+import { check, finish, testSetup } from './harness.mjs';
 
-const args = process.argv.slice(2);
-const option = (name, fallback) => {
-  const at = args.indexOf(name);
-  return at >= 0 ? args[at + 1] : fallback;
-};
-const cli = option('--cli');
-const dataDir = option('--data');
-const work = option('--work');
-const executablePath = option('--chromium', process.env.CHROMIUM ?? '/usr/bin/chromium');
-if (!cli || !dataDir || !work) {
-  console.error('usage: lines_browser.mjs --cli VERTEXFLOW --data DATA_DIR --work DIR [--chromium PATH]');
-  process.exit(2);
-}
-
-let passed = 0;
-let failed = 0;
-function check(condition, what, detail = '') {
-  if (condition) {
-    ++passed;
-    console.log(`ok: ${what}`);
-  } else {
-    ++failed;
-    console.log(`FAILED: ${what}${detail ? ` (${detail})` : ''}`);
-  }
-}
-
-rmSync(work, { recursive: true, force: true });
-mkdirSync(work, { recursive: true });
+const { cli, dataDir, work, executablePath } = testSetup(
+  'lines_browser.mjs --cli VERTEXFLOW --data DATA_DIR --work DIR [--chromium PATH]');
 const svg = path.join(work, 'bunny.svg');
 execFileSync(cli, ['--quiet', 'lines', path.join(dataDir, 'bunny_uniform.off'), svg, '--size', '800x600'],
   { stdio: ['ignore', 'inherit', 'inherit'] });
@@ -112,5 +86,4 @@ try {
 } finally {
   await browser.close();
 }
-console.log(`${passed} passed, ${failed} failed`);
-process.exit(failed === 0 ? 0 : 1);
+finish();

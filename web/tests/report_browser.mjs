@@ -11,40 +11,15 @@
 // and dragging the input view turns the result view too. Prints one line per check and
 // "N passed, M failed"; exit 1 on a failure.
 import { execFileSync } from 'node:child_process';
-import { mkdirSync, rmSync, statSync } from 'node:fs';
+import { statSync } from 'node:fs';
 import path from 'node:path';
 import { pathToFileURL } from 'node:url';
 import { chromium } from 'playwright-core';
+import { check, finish, testSetup } from './harness.mjs';
 
-const args = process.argv.slice(2);
-const option = (name, fallback) => {
-  const at = args.indexOf(name);
-  return at >= 0 ? args[at + 1] : fallback;
-};
-const cli = option('--cli');
-const dataDir = option('--data');
-const work = option('--work');
+const { args, cli, dataDir, work, executablePath } = testSetup(
+  'report_browser.mjs --cli VERTEXFLOW --data DATA_DIR --work DIR [--chromium PATH] [--shots]');
 const keepShots = args.includes('--shots');
-const executablePath = option('--chromium', process.env.CHROMIUM ?? '/usr/bin/chromium');
-if (!cli || !dataDir || !work) {
-  console.error('usage: report_browser.mjs --cli VERTEXFLOW --data DATA_DIR --work DIR [--chromium PATH] [--shots]');
-  process.exit(2);
-}
-
-let passed = 0;
-let failed = 0;
-function check(condition, what, detail = '') {
-  if (condition) {
-    ++passed;
-    console.log(`ok: ${what}`);
-  } else {
-    ++failed;
-    console.log(`FAILED: ${what}${detail ? ` (${detail})` : ''}`);
-  }
-}
-
-rmSync(work, { recursive: true, force: true });
-mkdirSync(work, { recursive: true });
 const run = (...cliArgs) => execFileSync(cli, ['--quiet', ...cliArgs], { stdio: ['ignore', 'inherit', 'inherit'] });
 const mesh = path.join(dataDir, 'fandisk.off');
 const enhanced = path.join(work, 'fandisk_enhanced.ply');
@@ -210,5 +185,4 @@ try {
 } finally {
   await browser.close();
 }
-console.log(`${passed} passed, ${failed} failed`);
-process.exit(failed === 0 ? 0 : 1);
+finish();
