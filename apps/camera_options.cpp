@@ -1,8 +1,6 @@
 // The camera options `render` and `lines` share (camera_options.h).
 #include "camera_options.h"
 
-#include <algorithm>
-#include <cctype>
 #include <map>
 #include <regex>
 
@@ -24,12 +22,19 @@ void add_camera_options(CLI::App* command, CameraCliOptions& camera) {
       ->excludes(frame_from);
 }
 
+std::pair<int, int> parse_image_size(const std::string& size) {
+  std::smatch match;
+  if (!std::regex_match(size, match, std::regex(R"((\d{1,5})[xX](\d{1,5}))")))
+    throw std::invalid_argument("--size " + size + ": expected WIDTHxHEIGHT, e.g. 1600x1200");
+  return {std::stoi(match[1]), std::stoi(match[2])};
+}
+
+nlohmann::json box_json(const BoundingBox& box) {
+  return {box.min.x(), box.min.y(), box.min.z(), box.max.x(), box.max.y(), box.max.z()};
+}
+
 void apply_camera_options(const CameraCliOptions& camera, RenderOptions& options, const GlobalOptions& global) {
-  std::smatch size;
-  if (!std::regex_match(camera.size, size, std::regex(R"((\d{1,5})[xX](\d{1,5}))")))
-    throw std::invalid_argument("--size " + camera.size + ": expected WIDTHxHEIGHT, e.g. 1600x1200");
-  options.width = std::stoi(size[1]);
-  options.height = std::stoi(size[2]);
+  std::tie(options.width, options.height) = parse_image_size(camera.size);
   const std::map<std::string, RenderView> views = {{"front", RenderView::Front},
                                                    {"side", RenderView::Side},
                                                    {"top", RenderView::Top},
@@ -45,16 +50,6 @@ void apply_camera_options(const CameraCliOptions& camera, RenderOptions& options
       throw std::invalid_argument("--frame: every max must be >= its min (xmin ymin zmin xmax ymax zmax)");
   }
   if (!camera.frame_from.empty()) options.frame = bounding_box(read_mesh_with_warnings(camera.frame_from, global).V);
-}
-
-}  // namespace vertexflow::cli
-
-namespace vertexflow::cli {
-
-std::string lowercase_extension(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
-  return ext;
 }
 
 }  // namespace vertexflow::cli

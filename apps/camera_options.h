@@ -20,15 +20,14 @@ struct CameraCliOptions {
 /// Registers the camera options on `command`.
 void add_camera_options(CLI::App* command, CameraCliOptions& camera);
 
+/// WIDTHxHEIGHT (--size) as (width, height). Throws std::invalid_argument when malformed.
+std::pair<int, int> parse_image_size(const std::string& size);
+
+/// A box as JSON: [xmin, ymin, zmin, xmax, ymax, zmax], as --frame takes it.
+nlohmann::json box_json(const BoundingBox& box);
+
 /// Sets options.view, azimuth, elevation, width, height and frame (reading --frame-from's
 /// mesh). Throws std::invalid_argument for a malformed --size or --frame.
 void apply_camera_options(const CameraCliOptions& camera, RenderOptions& options, const GlobalOptions& global);
-
-}  // namespace vertexflow::cli
-
-namespace vertexflow::cli {
-
-/// The extension of `path`, lowercase, with its dot (".png"); empty when it has none.
-std::string lowercase_extension(const std::string& path);
 
 }  // namespace vertexflow::cli

@@ -120,21 +120,17 @@ void register_lines_command(CLI::App& app, const GlobalOptions& global) {
       for (const LineType t : {LineType::Contour, LineType::SuggestiveContour, LineType::Ridge, LineType::Valley})
         counts[std::string(line_type_name(t))] = {{"extracted", drawing.extracted[static_cast<std::size_t>(t)]},
                                                   {"drawn", drawing.drawn[static_cast<std::size_t>(t)]}};
-      const BoundingBox frame = options.render.frame ? *options.render.frame : bounding_box(mesh.V);
-      fmt::print(
-          "{}\n",
-          nlohmann::json{
-              {"input", o->input},
-              {"output", o->output},
-              {"width", drawing.width},
-              {"height", drawing.height},
-              {"frame", {frame.min.x(), frame.min.y(), frame.min.z(), frame.max.x(), frame.max.y(), frame.max.z()}},
-              {"lines", counts},
-              {"seconds",
-               {{"lines", drawing.lines_seconds},
-                {"depth", drawing.depth_seconds},
-                {"visibility", drawing.visibility_seconds}}}}
-              .dump(2));
+      fmt::print("{}\n", nlohmann::json{{"input", o->input},
+                                        {"output", o->output},
+                                        {"width", drawing.width},
+                                        {"height", drawing.height},
+                                        {"frame", box_json(drawing.camera.frame)},
+                                        {"lines", counts},
+                                        {"seconds",
+                                         {{"lines", drawing.lines_seconds},
+                                          {"depth", drawing.depth_seconds},
+                                          {"visibility", drawing.visibility_seconds}}}}
+                             .dump(2));
     }
   });
 }
@@ -158,12 +154,7 @@ void register_compare_lines_command(CLI::App& app, const GlobalOptions& global) 
   add_line_options(command, o->lines);
   command->add_flag("--json", o->json, "Print the result as JSON on stdout");
   command->callback([o, &global] {
-    CameraCliOptions camera;
-    camera.size = o->size;
-    RenderOptions size;
-    apply_camera_options(camera, size, global);
-    o->fidelity.width = size.width;
-    o->fidelity.height = size.height;
+    std::tie(o->fidelity.width, o->fidelity.height) = parse_image_size(o->size);
     apply_line_options(o->lines, o->fidelity.drawing);
     const Mesh coarse = read_mesh_with_warnings(o->coarse, global);
     const Mesh dense = read_mesh_with_warnings(o->dense, global);

@@ -37,10 +37,6 @@ struct RenderCommandOptions {
   RenderOptions render;
 };
 
-nlohmann::json box_json(const BoundingBox& box) {
-  return {box.min.x(), box.min.y(), box.min.z(), box.max.x(), box.max.y(), box.max.z()};
-}
-
 }  // namespace
 
 void register_render_command(CLI::App& app, const GlobalOptions& global) {

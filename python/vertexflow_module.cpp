@@ -930,7 +930,8 @@ threads limits the TBB part; llvmpipe rasterises with LP_NUM_THREADS threads.)do
   m.def("feature_lines", &py_feature_lines, py::arg("V"), py::arg("F"), py::kw_only(),
         py::arg("direction") = py::none(), py::arg("eye") = py::none(), py::arg("contours") = true,
         py::arg("suggestive_contours") = true, py::arg("ridges") = true, py::arg("valleys") = true,
-        py::arg("suggestive_threshold") = 20.0, py::arg("ridge_threshold") = 25.0, py::arg("smoothing_scale") = 0.0,
+        py::arg("suggestive_threshold") = LineOptions{}.suggestive_threshold,
+        py::arg("ridge_threshold") = LineOptions{}.ridge_threshold, py::arg("smoothing_scale") = 0.0,
         py::arg("length_scale") = 0.0, py::arg("threads") = 0,
         R"doc(The feature lines as 3D polylines (lines.h) -> [{"type", "points" (N, 3), "closed"}].
 Orthographic along direction (default (0, 0, -1)) or perspective from eye. type is contours,
@@ -939,14 +940,17 @@ bounding-box diagonal). Hidden lines are not removed: line_drawing does that.)do
   m.def("line_drawing", &py_line_drawing, py::arg("V"), py::arg("F"), py::kw_only(), py::arg("width") = 800,
         py::arg("height") = 600, py::arg("view") = "iso", py::arg("azimuth") = 30.0, py::arg("elevation") = 20.0,
         py::arg("contours") = true, py::arg("suggestive_contours") = true, py::arg("ridges") = true,
-        py::arg("valleys") = true, py::arg("suggestive_threshold") = 20.0, py::arg("ridge_threshold") = 25.0,
-        py::arg("smoothing_scale") = 0.0, py::arg("length_scale") = 0.0, py::arg("hidden_line_removal") = true,
-        py::arg("line_width") = 1.5, py::arg("threads") = 0,
+        py::arg("valleys") = true, py::arg("suggestive_threshold") = LineOptions{}.suggestive_threshold,
+        py::arg("ridge_threshold") = LineOptions{}.ridge_threshold, py::arg("smoothing_scale") = 0.0,
+        py::arg("length_scale") = 0.0, py::arg("hidden_line_removal") = true, py::arg("line_width") = 1.5,
+        py::arg("threads") = 0,
         R"doc(`vertexflow lines` in memory (line_drawing.h) -> {"lines": [{"type", "points" (N, 2) pixels}],
 "svg": str, "width", "height"}: render's camera, hidden lines removed with its depth buffer.)doc");
   m.def("compare_lines", &py_compare_lines, py::arg("V_coarse"), py::arg("F_coarse"), py::arg("V_dense"),
-        py::arg("F_dense"), py::kw_only(), py::arg("views") = 8, py::arg("elevation") = 15.0, py::arg("width") = 800,
-        py::arg("height") = 600, py::arg("match_pixels") = 2.0, py::arg("threads") = 0,
+        py::arg("F_dense"), py::kw_only(), py::arg("views") = LineFidelityOptions{}.views,
+        py::arg("elevation") = LineFidelityOptions{}.elevation_degrees, py::arg("width") = LineFidelityOptions{}.width,
+        py::arg("height") = LineFidelityOptions{}.height, py::arg("match_pixels") = LineFidelityOptions{}.match_pixels,
+        py::arg("threads") = 0,
         R"doc(`vertexflow compare-lines`: line-drawing fidelity of the coarse mesh against the dense one
 (line_drawing.h) -> {"precision", "recall", "f1", "views": [per view]}.)doc");
   m.def("enhance_file", &py_enhance_file, py::arg("input"), py::arg("output"),

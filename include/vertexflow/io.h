@@ -60,6 +60,9 @@ inline constexpr std::size_t kMaxCommentBytes = 1024;
 /// "OBJ", "PLY", "OFF" or "STL".
 const char* format_name(MeshFormat format);
 
+/// The extension of `path` with its dot, lowercase (".ply"); empty when it has none.
+std::string lowercase_extension(const std::filesystem::path& path);
+
 /// File format from the extension (case-insensitive, a trailing ".gz" ignored).
 /// Throws IoError for an unknown extension.
 MeshFormat format_from_path(const std::filesystem::path& path);

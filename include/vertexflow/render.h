@@ -137,6 +137,7 @@ struct RenderCamera {
   /// Orthonormal basis: `back` points from the scene towards the camera (the viewing direction
   /// is -back), `up` is the image's up, right = up x back.
   Eigen::Vector3d right = Eigen::Vector3d::UnitX(), up = Eigen::Vector3d::UnitY(), back = Eigen::Vector3d::UnitZ();
+  BoundingBox frame;                                 ///< the camera frame (options.frame or V's box)
   Eigen::Vector3d centre = Eigen::Vector3d::Zero();  ///< the frame's centre
   double pixels_per_unit = 1;                        ///< image scale
   double centre_x = 0, centre_y = 0;                 ///< where the centre lands, in pixels

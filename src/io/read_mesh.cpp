@@ -364,15 +364,11 @@ Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& repor
 
 }  // namespace io_detail
 
-namespace {
-
 std::string lowercase_extension(const std::filesystem::path& path) {
   std::string ext = path.extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
   return ext;
 }
-
-}  // namespace
 
 bool is_gzip_path(const std::filesystem::path& path) { return lowercase_extension(path) == ".gz"; }
 

@@ -17,8 +17,6 @@
 namespace vertexflow {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
 struct Style {
   const char* color;          // SVG colour
   std::array<double, 3> rgb;  // the same for cairo
@@ -87,7 +85,7 @@ void visible_pieces(const Polyline& line, const RenderCamera& camera, const Dept
   flush();
 }
 
-// Cairo surface of the drawing's size, filled from `underlay` (RGBA) or white.
+// Owning handles of cairo objects.
 using Surface = std::unique_ptr<cairo_surface_t, decltype(&cairo_surface_destroy)>;
 using Context = std::unique_ptr<cairo_t, decltype(&cairo_destroy)>;
 
@@ -131,17 +129,18 @@ LineDrawing draw_lines(const Mesh& mesh, const LineDrawingOptions& options) {
   LineDrawing drawing;
   drawing.width = options.render.width;
   drawing.height = options.render.height;
-  drawing.camera = render_camera(mesh.V, options.render);
+  // The depth pass computes the camera; without it, the camera alone.
   auto start = Clock::now();
+  std::optional<DepthImage> depth;
+  if (options.hidden_line_removal) depth = render_depth(mesh, options.render);
+  drawing.depth_seconds = seconds_since(start);
+  drawing.camera = depth ? depth->camera : render_camera(mesh.V, options.render);
+  start = Clock::now();
   View view;
   view.orthographic = true;
   view.direction = -drawing.camera.back;
   const std::vector<Polyline> lines = feature_lines(mesh.V, mesh.F, view, options.lines);
   drawing.lines_seconds = seconds_since(start);
-  start = Clock::now();
-  std::optional<DepthImage> depth;
-  if (options.hidden_line_removal) depth = render_depth(mesh, options.render);
-  drawing.depth_seconds = seconds_since(start);
   start = Clock::now();
   const double slack = options.depth_tolerance_pixels / drawing.camera.pixels_per_unit;
   for (const Polyline& line : lines) {
@@ -262,10 +261,11 @@ LineFidelity line_drawing_fidelity(const Mesh& coarse, const Mesh& dense, const 
   LineDrawingOptions drawing = options.drawing;
   drawing.render.width = options.width;
   drawing.render.height = options.height;
-  drawing.render.frame = bounding_box(dense.V);
+  const BoundingBox dense_box = bounding_box(dense.V);
+  drawing.render.frame = dense_box;
   drawing.render.view = RenderView::Custom;
   drawing.render.elevation_degrees = options.elevation_degrees;
-  if (drawing.lines.length_scale == 0) drawing.lines.length_scale = bounding_box(dense.V).diagonal();
+  if (drawing.lines.length_scale == 0) drawing.lines.length_scale = dense_box.diagonal();
   LineFidelity result;
   for (int v = 0; v < options.views; ++v) {
     drawing.render.azimuth_degrees = 360.0 * v / options.views;

@@ -98,13 +98,8 @@ ScalarField scalar_field(const Mesh& mesh, const RenderOptions& options, const T
   return field;
 }
 
-// Orthonormal camera basis: `back` points from the scene towards the camera, `up` is the
-// image's up direction, right = up x back.
-struct Camera {
-  Eigen::Vector3d right, up, back;
-};
-
-Camera camera_for(const RenderOptions& options) {
+// The orthonormal basis of the view (RenderCamera's right, up, back; render.h's conventions).
+RenderCamera camera_for(const RenderOptions& options) {
   double azimuth = 0, elevation = 0;
   switch (options.view) {
     case RenderView::Front:
@@ -124,7 +119,7 @@ Camera camera_for(const RenderOptions& options) {
       break;
   }
   const double a = azimuth * std::numbers::pi / 180, e = elevation * std::numbers::pi / 180;
-  Camera c;
+  RenderCamera c;
   c.back = Eigen::Vector3d(std::cos(e) * std::sin(a), std::sin(e), std::cos(e) * std::cos(a));
   // Up is +y projected into the image plane. Looking straight down (or up) that is undefined;
   // then up is the horizontal direction away from the camera's azimuth, as if the camera had
@@ -462,10 +457,9 @@ void check_options(const Mesh& mesh, const RenderOptions& options) {
 
 RenderCamera render_camera(const Vertices& V, const RenderOptions& options) {
   check_camera_options(options);
-  const BoundingBox frame = options.frame ? *options.frame : bounding_box(V);
-  const Camera basis = camera_for(options);
-  RenderCamera c;
-  c.right = basis.right, c.up = basis.up, c.back = basis.back;
+  RenderCamera c = camera_for(options);
+  c.frame = options.frame ? *options.frame : bounding_box(V);
+  const BoundingBox& frame = c.frame;
   c.width = options.width, c.height = options.height;
   c.centre = 0.5 * (frame.min + frame.max);
   double radius = 0.5 * frame.diagonal();
@@ -647,7 +641,7 @@ Image render_mesh(const Mesh& mesh, const RenderOptions& options, RenderInfo* in
     info->color_quantity = field.scale.quantity;
     info->color_min = field.values.size() ? field.scale.lo : 0;
     info->color_max = field.values.size() ? field.scale.hi : 0;
-    info->frame = options.frame ? *options.frame : bounding_box(mesh.V);
+    info->frame = view.frame;
     info->camera = view;
     info->prepare_seconds = prepare_seconds;
     info->draw_seconds = draw_seconds;

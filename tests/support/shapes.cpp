@@ -233,17 +233,7 @@ Mesh roof(int n, bool across) {
 }
 
 Mesh saddle(double half, int n) {
-  std::vector<Eigen::Vector3d> p;
-  for (int i = 0; i <= n; ++i) {
-    for (int j = 0; j <= n; ++j) {
-      const double x = -half + 2 * half * i / n, y = -half + 2 * half * j / n;
-      p.emplace_back(x, y, 0.5 * (x * x - y * y));
-    }
-  }
-  std::vector<Eigen::Vector3i> f;
-  grid_triangles(
-      n, n, [&](int i, int j) { return i * (n + 1) + j; }, f);
-  return from_lists(p, f);
+  return height_field(half, n, [](double x, double y) { return 0.5 * (x * x - y * y); });
 }
 
 Mesh bowtie() {
