@@ -17,6 +17,7 @@
 #include <cerrno>
 #include <csignal>
 #include <cstdlib>
+#include <ctime>
 #include <mutex>
 #include <random>
 
@@ -36,12 +37,33 @@ struct TemporarySlot {
 // Concurrent writes; a write beyond that many is simply not protected.
 std::array<TemporarySlot, 16> temporary_slots;
 
+// Blocks SIGINT and SIGTERM in the calling thread for its lifetime. Every slot is filled and
+// armed (or released) under one, so the handler never runs on the thread that holds a Filling
+// slot and may wait for it.
+class FillingGuard {
+ public:
+  FillingGuard() {
+    sigset_t blocked;
+    sigemptyset(&blocked);
+    sigaddset(&blocked, SIGINT);
+    sigaddset(&blocked, SIGTERM);
+    ::pthread_sigmask(SIG_BLOCK, &blocked, &before_);
+  }
+  FillingGuard(const FillingGuard&) = delete;
+  FillingGuard& operator=(const FillingGuard&) = delete;
+  ~FillingGuard() { ::pthread_sigmask(SIG_SETMASK, &before_, nullptr); }
+
+ private:
+  sigset_t before_{};
+};
+
 class TemporaryRegistry {
  public:
   static constexpr int kNone = -1;
 
   // Reserves a slot for the file `name` before it is created; kNone if every slot is busy or
-  // the path is too long, and then the file is simply not protected.
+  // the path is too long, and then the file is simply not protected. Call under a FillingGuard
+  // and arm() or release() the slot before the guard ends.
   static int reserve(const std::string& name) {
     install_handlers();
     // Absolute, in case the working directory changes before a signal comes.
@@ -77,6 +99,16 @@ class TemporaryRegistry {
 
   static void handle(int signal) {
     for (TemporarySlot& slot : temporary_slots) {
+      // A Filling slot belongs to a thread that has these signals blocked (FillingGuard), so
+      // this is another thread: wait the few microseconds until its open() or linkat() has
+      // returned and the slot is Armed or Free. Skipping it left the file behind (seen in CI:
+      // SIGTERM delivered to a worker thread while the main thread was inside linkat()).
+      int state = slot.state.load();
+      while (state == kFilling) {
+        const timespec pause{0, 100'000};
+        ::nanosleep(&pause, nullptr);  // async-signal-safe
+        state = slot.state.load();
+      }
       int expected = kArmed;
       if (slot.state.compare_exchange_strong(expected, kTaken)) ::unlink(slot.path);
     }
@@ -150,21 +182,21 @@ class AtomicFile {
     // O_EXCL with a random suffix makes the name ours; mode 0666 and the umask give the file
     // its usual permissions (mkstemp would give 0600).
     for (int attempt = 0; attempt < 100 && fd_ < 0; ++attempt) {
-      temp_ = random_hidden_name(target_);
-      slot_ = TemporaryRegistry::reserve(temp_);
-      // SIGINT and SIGTERM wait while the file is created and armed: a signal between the two
-      // left the file behind (seen once in CI, killed right as the write began).
-      sigset_t creating, before;
-      sigemptyset(&creating);
-      sigaddset(&creating, SIGINT);
-      sigaddset(&creating, SIGTERM);
-      ::pthread_sigmask(SIG_BLOCK, &creating, &before);
-      fd_ = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
-      const int error = errno;
-      if (fd_ >= 0) TemporaryRegistry::arm(slot_);
-      ::pthread_sigmask(SIG_SETMASK, &before, nullptr);
-      if (fd_ >= 0) break;
-      TemporaryRegistry::release(slot_);
+      int error = 0;
+      {
+        // SIGINT and SIGTERM wait in this thread while the file is created and armed: a signal
+        // between the two left the file behind (seen once in CI, killed as the write began).
+        const FillingGuard guard;
+        temp_ = random_hidden_name(target_);
+        slot_ = TemporaryRegistry::reserve(temp_);
+        fd_ = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
+        error = errno;
+        if (fd_ >= 0) {
+          TemporaryRegistry::arm(slot_);
+          break;
+        }
+        TemporaryRegistry::release(slot_);
+      }
       slot_ = TemporaryRegistry::kNone;
       temp_.clear();
       if (error != EEXIST) cannot_create(error);
@@ -216,6 +248,7 @@ class AtomicFile {
   void link_unnamed() {
     const std::string proc = "/proc/self/fd/" + std::to_string(fd_);
     for (int attempt = 0; attempt < 100; ++attempt) {
+      const FillingGuard guard;  // as in the constructor: no signal between linkat and arm
       std::string name = random_hidden_name(target_);
       slot_ = TemporaryRegistry::reserve(name);
       if (::linkat(AT_FDCWD, proc.c_str(), AT_FDCWD, name.c_str(), AT_SYMLINK_FOLLOW) == 0) {
