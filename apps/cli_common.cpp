@@ -47,18 +47,29 @@ void check_outputs(const std::vector<std::filesystem::path>& inputs, const std::
 }
 
 namespace {
-std::string& last_input() {
-  static std::string path;
-  return path;
+// Every mesh file read so far, in order.
+std::vector<std::string>& inputs_read() {
+  static std::vector<std::string> paths;
+  return paths;
 }
 }  // namespace
 
 const std::string& last_input_path() {
-  return last_input();
+  static const std::string none;
+  return inputs_read().empty() ? none : inputs_read().back();
+}
+
+bool names_an_input(std::string_view message) {
+  for (const std::string& path : inputs_read()) {
+    if (message.size() > path.size() + 1 && message.substr(0, path.size()) == path &&
+        message.substr(path.size(), 2) == ": ")
+      return true;
+  }
+  return false;
 }
 
 Mesh read_mesh_with_warnings(const std::filesystem::path& path, const GlobalOptions& global, ReadReport* report) {
-  last_input() = path.string();
+  inputs_read().push_back(path.string());
   ReadReport local;
   ReadReport& r = report ? *report : local;
   Mesh mesh = read_mesh(path, &r);

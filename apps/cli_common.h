@@ -12,6 +12,7 @@
 
 #include <filesystem>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace vertexflow::cli {
@@ -46,6 +47,11 @@ void check_outputs(const std::vector<std::filesystem::path>& inputs, const std::
 /// The mesh file read_mesh_with_warnings read last (empty before any): std::bad_alloc names no
 /// file, so main() takes this one for its one-line "out of memory" error.
 const std::string& last_input_path();
+
+/// Whether `message` starts with "PATH: " for a mesh file read so far: main() adds no prefix
+/// then (enhance --reference reads the input, then the reference, and an error about the input
+/// must not be prefixed with the reference).
+bool names_an_input(std::string_view message);
 
 /// Human-readable format name, e.g. "PLY (binary)".
 std::string describe_format(const ReadReport& report);

@@ -52,9 +52,7 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     // The computation's errors (and the system's, such as a thread that cannot start) concern
     // the mesh read last.
-    const std::string prefix = input_prefix();
-    const bool named = std::string_view(e.what()).substr(0, prefix.size()) == prefix;
-    fmt::print(stderr, "vertexflow: error: {}{}\n", named ? "" : prefix, e.what());
+    fmt::print(stderr, "vertexflow: error: {}{}\n", names_an_input(e.what()) ? "" : input_prefix(), e.what());
     return 1;
   }
   return 0;

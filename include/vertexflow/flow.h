@@ -191,8 +191,10 @@ FlowResult vertex_flow(const Vertices& V, const Faces& F, const Topology& topolo
 /// inscribed in S, like the input's, not lower (fit_to_reference, fit.h, lowers it). Features,
 /// boundaries, pins and the guard as vertex_flow (the guard's shortened vertices are not
 /// projected). (VS, FS) is any triangle mesh of S, in the input's units. Throws as vertex_flow,
-/// and std::invalid_argument for an empty S, a non-finite coordinate of S, or a mesh that is
-/// not manifold and oriented (the reference flow has no manifold split).
+/// and std::invalid_argument for an empty S or a non-finite coordinate of S. A non-manifold or
+/// inconsistently oriented input is handled as by vertex_flow (its manifold split flows on S,
+/// its non-manifold vertices held) unless options.refuse_non_manifold. S itself may be any
+/// triangle soup that principal_curvatures and the closest-point query accept.
 FlowResult vertex_flow_on_reference(const Vertices& V, const Faces& F, const Vertices& VS, const Faces& FS,
                                     const FlowOptions& options = {});
 

@@ -47,10 +47,14 @@ void validate_flow_options(const FlowOptions& o, Index num_vertices) {
 
 namespace {
 
-// Flows the manifold split of a non-manifold or inconsistently oriented mesh (flow.h): the
-// copies of held vertices are pinned, so every input vertex has one position to return.
+FlowResult check_then(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options,
+                      const Mesh* reference);
+
+// Flows the manifold split of a non-manifold or inconsistently oriented mesh (flow.h), on the
+// input or on the reference: the copies of held vertices are pinned, so every input vertex has
+// one position to return.
 FlowResult flow_on_manifold_split(const Vertices& V, const Faces& F, const Topology& topology,
-                                  const FlowOptions& options) {
+                                  const FlowOptions& options, const Mesh* reference) {
   const ManifoldSplit split = split_non_manifold(V, F, topology);
   FlowOptions on_split = options;
   on_split.refuse_non_manifold = true;  // the split is manifold and oriented (manifold_split.h)
@@ -63,7 +67,7 @@ FlowResult flow_on_manifold_split(const Vertices& V, const Faces& F, const Topol
   for (const Index v : options.pinned) pin_copies(v);
   for (Index v = 0; v < static_cast<Index>(V.rows()); ++v)
     if (split.held[static_cast<std::size_t>(v)]) pin_copies(v);
-  FlowResult on_copies = vertex_flow(split.V, split.F, build_topology(split.F, split.V.rows()), on_split);
+  FlowResult on_copies = check_then(split.V, split.F, build_topology(split.F, split.V.rows()), on_split, reference);
   FlowResult result;
   result.report = on_copies.report;
   result.V = V;
@@ -110,8 +114,9 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
     const Vertices start_of_round = X;
     // One solve: minimise the energy for positions X, frozen curvature of X.
     auto start = Clock::now();
-    const FlowFrame frame = surface ? flow_frame_on_reference(X, F, topology, options, setup.sliver_faces, *surface)
-                                    : flow_frame(X, F, topology, options, setup.sliver_faces);
+    const FlowFrame frame = surface
+                                ? flow_frame_on_reference(X, F, topology, options, setup.sliver_faces, *surface, fixed)
+                                : flow_frame(X, F, topology, options, setup.sliver_faces);
     report.d = frame.d;
     report.seconds_curvature += seconds_since(start);
     X = solver.solve(frame, options.weights, report);
@@ -180,7 +185,7 @@ FlowResult check_then(const Vertices& V, const Faces& F, const Topology& topolog
       throw std::invalid_argument("vertex flow: " + (topology.is_manifold()
                                                          ? std::string("the faces are not consistently oriented")
                                                          : describe_non_manifold(topology)));
-    return flow_on_manifold_split(V, F, topology, options);
+    return flow_on_manifold_split(V, F, topology, options, reference);
   }
   return flow_rounds(V, F, topology, options, reference);
 }
@@ -197,14 +202,12 @@ FlowResult vertex_flow_on_reference(const Vertices& V, const Faces& F, const Ver
     throw std::invalid_argument("vertex flow on a reference: the reference is empty");
   if (!VS.allFinite())
     throw std::invalid_argument("vertex flow on a reference: a vertex of the reference has a non-finite coordinate");
-  FlowOptions strict = options;
-  strict.refuse_non_manifold = true;  // no manifold split: refuse rather than flow a split
   if (V.rows() == 0 || F.rows() == 0) throw std::invalid_argument("vertex flow: the mesh is empty");
   const Topology topology = build_topology(F, static_cast<Index>(V.rows()));
   Mesh reference;
   reference.V = VS;
   reference.F = FS;
-  return check_then(V, F, topology, strict, &reference);
+  return check_then(V, F, topology, options, &reference);
 }
 
 }  // namespace vertexflow

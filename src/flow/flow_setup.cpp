@@ -88,7 +88,7 @@ FlowFrame flow_frame(const Vertices& X, const Faces& F, const Topology& topology
 
 FlowFrame flow_frame_on_reference(const Vertices& X, const Faces& F, const Topology& topology,
                                   const FlowOptions& options, const std::vector<Index>& sliver_faces,
-                                  const ReferenceSurface& surface) {
+                                  const ReferenceSurface& surface, const std::vector<char>& fixed) {
   FlowFrame frame = flow_frame(X, F, topology, options, sliver_faces);
   const std::vector<ClosestPoint> feet = surface.query.closest_points(X);
   const Faces& FS = surface.query.faces();
@@ -96,7 +96,7 @@ FlowFrame flow_frame_on_reference(const Vertices& X, const Faces& F, const Topol
   Curvature& c = frame.curvature;
   parallel_for_index(X.rows(), [&](Index i) {
     const ClosestPoint& foot = feet[static_cast<std::size_t>(i)];
-    frame.P.row(i) = foot.point.transpose();
+    if (!fixed[static_cast<std::size_t>(i)]) frame.P.row(i) = foot.point.transpose();
     // The shape operators of the face's corners, blended: sum b_k (k1 T1 T1^T + k2 T2 T2^T)_k.
     Eigen::Matrix3d shape = Eigen::Matrix3d::Zero();
     Eigen::Vector3d normal = Eigen::Vector3d::Zero();

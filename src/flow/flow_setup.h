@@ -50,9 +50,11 @@ struct ReferenceSurface {
 
 /// The frame of flow_frame with the anchors P and the curvature (k1, k2, T1, T2, N) taken from S
 /// at the foot points of X (flow.h, vertex_flow_on_reference); the areas and d from X's and
-/// S's curvature as flow_frame.
+/// S's curvature as flow_frame. A `fixed` vertex keeps its anchor at X: the solver returns
+/// fixed vertices at their anchors, and one moved onto S would be judged there by the guard,
+/// then put back, unguarded, at the end.
 FlowFrame flow_frame_on_reference(const Vertices& X, const Faces& F, const Topology& topology,
                                   const FlowOptions& options, const std::vector<Index>& sliver_faces,
-                                  const ReferenceSurface& surface);
+                                  const ReferenceSurface& surface, const std::vector<char>& fixed);
 
 }  // namespace vertexflow

@@ -195,6 +195,25 @@ TEST(CliEnhance, NonManifoldInputIsHeldWhereItMustBeOrRefusedWithStrict) {
   EXPECT_NE(strict.err.find("bowtie.obj: vertex flow: the mesh is not manifold"), std::string::npos) << strict.err;
   EXPECT_EQ(std::count(strict.err.begin(), strict.err.end(), '\n'), 1) << strict.err;
   EXPECT_FALSE(std::filesystem::exists(out));
+
+  // The same with the flow on a reference: held without --strict; with it, the one line names
+  // the input alone, not the reference read after it (it used to read "REFERENCE: INPUT: ...").
+  const std::string on_reference =
+      " --reference " + test::quoted_data_path("sphere_low.off") + " --reference-method flow";
+  const auto held_on_reference =
+      run_cli("enhance " + shell_quote(bowtie.string()) + " " + shell_quote(out.string()) + on_reference);
+  EXPECT_EQ(held_on_reference.exit_code, 0) << held_on_reference.err;
+  EXPECT_NE(held_on_reference.err.find("1 vertices held"), std::string::npos) << held_on_reference.err;
+  std::filesystem::remove(out);
+  const auto strict_on_reference = run_cli("--quiet enhance " + shell_quote(bowtie.string()) + " " +
+                                           shell_quote(out.string()) + on_reference + " --strict");
+  EXPECT_EQ(strict_on_reference.exit_code, 1);
+  EXPECT_EQ(strict_on_reference.err.rfind(
+                "vertexflow: error: " + bowtie.string() + ": vertex flow: the mesh is not manifold", 0),
+            0)
+      << strict_on_reference.err;
+  EXPECT_EQ(strict_on_reference.err.find("sphere_low.off"), std::string::npos) << strict_on_reference.err;
+  EXPECT_FALSE(std::filesystem::exists(out));
 }
 
 }  // namespace
