@@ -147,6 +147,18 @@ void add_flow_options(CLI::App* command, FlowOptions& flow, bool& no_projection)
                    "edges (0: the guard alone)")
       ->check(CLI::NonNegativeNumber)
       ->capture_default_str();
+  command
+      ->add_option("--density-passes", flow.density.passes,
+                   "Density-weighted centroidal passes after the solve, which move vertices towards curvature where "
+                   "the mesh's connectivity holds the flow back (vertex-clustered scans); 0: the paper's flow alone "
+                   "(flow.h, DensityRelaxation)")
+      ->check(CLI::Range(0, 1000))
+      ->capture_default_str();
+  command
+      ->add_option("--density-exponent", flow.density.exponent,
+                   "Density passes: sizing density (0.1 + (|k1| + |k2|) * mean edge length)^this; 0 equalises areas")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
   command->add_flag("--no-projection", no_projection,
                     "Leave vertices where the solve puts them instead of moving them onto the input surface");
   command

@@ -384,12 +384,13 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     if (fit) o->method = "reference";
     if (reference_flow) o->method = "reference-flow";
     if (smooth) o->method = "smooth";
-    for (const char* name : {"--lambda", "--mu", "--iterations", "--min-quality", "--no-projection", "--fairness",
-                             "--feature-angle", "--solver", "--sliver-floor", "--sliver-stiffness"})
+    for (const char* name :
+         {"--lambda", "--mu", "--iterations", "--min-quality", "--no-projection", "--fairness", "--feature-angle",
+          "--solver", "--sliver-floor", "--sliver-stiffness", "--density-passes", "--density-exponent"})
       if (unsharp && command->count(name) > 0)
         throw std::runtime_error(std::string(name) + " applies to --method flow only");
     for (const char* name : {"--lambda", "--mu", "--iterations", "--no-projection", "--fairness", "--feature-angle",
-                             "--solver", "--strict", "--sliver-stiffness"})
+                             "--solver", "--strict", "--sliver-stiffness", "--density-passes", "--density-exponent"})
       if ((fit || smooth) && command->count(name) > 0 && !(smooth && std::string(name) == "--feature-angle"))
         throw std::runtime_error(std::string(name) + " does not apply to " +
                                  (fit ? "--reference" : "--surface smooth"));

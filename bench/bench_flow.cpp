@@ -10,7 +10,8 @@
 // "pipeline_ms" is curvature + assembly + factorisation + solve, the part the targets
 // are about (no I/O, no projection, no guard). Cases named .../direct, .../iterative and
 // .../multilevel force the solver, to compare the paths; the others use
-// LinearSolver::Automatic.
+// LinearSolver::Automatic. Cases named .../density-30 add 30 density passes
+// (FlowOptions::density); "density_ms" is their time.
 #include "bench_support.h"
 
 #include "vertexflow/flow.h"
@@ -91,10 +92,11 @@ const Mesh& mesh(const std::string& name) {
   return cache.emplace(name, std::move(m)).first->second;
 }
 
-void run(benchmark::State& state, const std::string& name, LinearSolver solver) {
+void run(benchmark::State& state, const std::string& name, LinearSolver solver, int density_passes = 0) {
   const Mesh& input = mesh(name);
   FlowOptions options;
   options.solver = solver;
+  options.density.passes = density_passes;
   FlowReport sum;
   double cpu = 0;
   int iterations = 0;
@@ -110,6 +112,7 @@ void run(benchmark::State& state, const std::string& name, LinearSolver solver) 
     sum.seconds_solve += r.seconds_solve;
     sum.seconds_projection += r.seconds_projection;
     sum.seconds_guard += r.seconds_guard;
+    sum.seconds_density += r.seconds_density;
     sum.solver_used = r.solver_used;
     sum.solver_iterations = r.solver_iterations;
     sum.solver_error = r.solver_error;
@@ -123,6 +126,7 @@ void run(benchmark::State& state, const std::string& name, LinearSolver solver) 
   state.counters["solve_ms"] = sum.seconds_solve * per_run_ms;
   state.counters["projection_ms"] = sum.seconds_projection * per_run_ms;
   state.counters["guard_ms"] = sum.seconds_guard * per_run_ms;
+  if (density_passes > 0) state.counters["density_ms"] = sum.seconds_density * per_run_ms;
   state.counters["pipeline_ms"] =
       (sum.seconds_curvature + sum.seconds_assembly + sum.seconds_factorization + sum.seconds_solve) * per_run_ms;
   state.counters["process_cpu_ms"] = cpu * per_run_ms;
@@ -146,6 +150,14 @@ void register_cases() {
         ("flow/" + name).c_str(), [name](benchmark::State& state) { run(state, name, LinearSolver::Automatic); });
     automatic->Unit(benchmark::kMillisecond)->UseRealTime();
     if (large) automatic->Iterations(1);
+    // FlowOptions::density: 30 passes (what reaches rho +0.2 on the vertex-clustered bunnies).
+    if (name == "horse-10k" || name == "amo.off" || name == "armadillo-1M") {
+      auto* passes = benchmark::RegisterBenchmark(
+          ("flow/" + name + "/density-30").c_str(),
+          [name](benchmark::State& state) { run(state, name, LinearSolver::Automatic, 30); });
+      passes->Unit(benchmark::kMillisecond)->UseRealTime();
+      if (large) passes->Iterations(1);
+    }
     if (name == "armadillo-1M") continue;  // the coupled factorisation does not fit (16 GB)
     for (const LinearSolver forced : {LinearSolver::Direct, LinearSolver::Iterative, LinearSolver::Multilevel}) {
       const std::string suffix = forced == LinearSolver::Direct      ? "/direct"

@@ -48,6 +48,14 @@ int main(int argc, char** argv) {
       o.min_quality = v;
     else if (k == "csmooth")
       o.curvature.smoothing_rounds = static_cast<int>(v);
+    else if (k == "dpasses")
+      o.density.passes = static_cast<int>(v);
+    else if (k == "dexp")
+      o.density.exponent = v;
+    else if (k == "deps")
+      o.density.epsilon = v;
+    else if (k == "dstep")
+      o.density.step = v;
     else if (k == "fair")
       o.weights.fairness_target = v != 0 ? FairnessTarget::InputNormal : FairnessTarget::Zero;
     else {

@@ -287,6 +287,14 @@ const std::map<std::string, FlowSetter>& flow_setters() {
        }},
       {"solver_tolerance", [](FlowOptions& o, const std::string& k,
                               const py::handle& v) { o.solver_tolerance = cast_option<double>(k, v); }},
+      {"density_passes",
+       [](FlowOptions& o, const std::string& k, const py::handle& v) { o.density.passes = cast_option<int>(k, v); }},
+      {"density_exponent", [](FlowOptions& o, const std::string& k,
+                              const py::handle& v) { o.density.exponent = cast_option<double>(k, v); }},
+      {"density_epsilon", [](FlowOptions& o, const std::string& k,
+                             const py::handle& v) { o.density.epsilon = cast_option<double>(k, v); }},
+      {"density_step",
+       [](FlowOptions& o, const std::string& k, const py::handle& v) { o.density.step = cast_option<double>(k, v); }},
   };
   return setters;
 }
@@ -889,7 +897,8 @@ k1 >= k2 (n,) arrays, T1, T2, N unit (n, 3) arrays. Convex with outward normals 
         epsilon=1e-6, sliver=0.02, fairness_target="input-normal", d_percentile=99.0,
         project_to_input=True, feature_angle=40.0, fix_boundary=True, refuse_non_manifold=False,
         max_halvings=30, min_quality=0.3, sliver_floor=0.5, curvature_smoothing_rounds=0,
-        normal_weighting="max1999", solver="automatic", solver_tolerance=1e-7, max_rounds=None,
+        normal_weighting="max1999", solver="automatic", solver_tolerance=1e-7, density_passes=0,
+        density_exponent=2.0, density_epsilon=0.1, density_step=0.5, max_rounds=None,
         reference_method="fit", assume_on_surface=False, provenance=None, threads=0,
         progress=None) -> (V_out, report)
 

@@ -19,6 +19,9 @@
 // rest flows. The result has the input's vertices and faces, in order. FlowReport counts what
 // was held; FlowOptions::refuse_non_manifold refuses such meshes instead.
 //
+// Beyond the paper: FlowOptions::density adds density-weighted centroidal passes after the
+// solves (off by default; DensityRelaxation says what they do and cost).
+//
 // Side effect: the sparse Cholesky runs with one BLAS thread, and vertex_flow sets the process's
 // OpenBLAS thread count to 1 (when OpenBLAS is the BLAS): Debian's threaded OpenBLAS made the
 // factorisation slower on 2 cores and its results depend on the thread count.
@@ -63,6 +66,30 @@ enum class LinearSolver {
   /// flat regions, where only F_smo's bi-Laplacian holds the vertices; its set-up costs about
   /// 20-60 block-Jacobi iterations.
   Multilevel,
+};
+
+/// Density-weighted centroidal passes after the solves (FlowOptions::density). Not part of the
+/// paper's energy: on inputs whose vertex areas vary for reasons other than curvature (vertex
+/// clustering, some scans), the edge and fairness terms of the paper pull towards an
+/// equilibrium set by the connectivity (a vertex's area grows with its valence) more than by
+/// curvature, and the redistribution the flow exists for hardly shows (docs/redistribution.md).
+///
+/// Each pass moves every free vertex `step` of the way to the centroid of its faces'
+/// centroids, weighted by face area times the face's sizing density (the mean of its corners'
+///
+///     density(v) = (epsilon + (|k1| + |k2|) * mean edge length)^exponent,
+///
+/// with the curvature of the surface the flow runs on: the input's, or the reference's at the
+/// foot points), then projects it onto that surface as the solve's result is, and guards the
+/// pass as a solve (FlowOptions::min_quality). Repeated, the passes equalise area times
+/// density around the vertices (a centroidal Voronoi relaxation on the fixed one-rings), which
+/// puts vertices where the curvature is. exponent 2 asks for edge lengths like 1 / |k|; 0 makes
+/// the passes an area-equalising tangential relaxation (CGAL's tangential_relaxation).
+struct DensityRelaxation {
+  int passes = 0;         ///< 0: the paper's flow alone
+  double exponent = 2.0;  ///< >= 0
+  double epsilon = 0.1;   ///< > 0: the density of a flat region, per mean edge length
+  double step = 0.5;      ///< in (0, 1]: the fraction of the way to the centroid per pass
 };
 
 struct FlowOptions {
@@ -137,6 +164,8 @@ struct FlowOptions {
   /// 1e-9 (within 3e-7); 1e-6 saves another 10-20% but reaches 4e-4 on fandisk. The flow moves
   /// vertices by 0.1-3 mean edge lengths and projects them onto the input afterwards.
   double solver_tolerance = 1e-7;
+  /// Density-weighted centroidal passes after the solves (none by default; DensityRelaxation).
+  DensityRelaxation density;
 };
 
 struct FlowReport {
@@ -147,12 +176,14 @@ struct FlowReport {
   Index flipped_before_guard = 0;      ///< faces the unguarded solution turned or degenerated
   Index low_quality_before_guard = 0;  ///< faces it left below their quality floor
   Index limited_vertices = 0;          ///< vertices the guard left short of their proposed move (any solve)
+  Index density_limited_vertices = 0;  ///< the same for the density passes (FlowOptions::density), any pass
   Index fixed_vertices = 0;            ///< boundary, pinned, isolated and corner vertices
   /// Non-manifold input (manifold_split.h), all 0 for a manifold, oriented mesh:
   Index held_non_manifold_vertices = 0;  ///< vertices held because their faces form more than one fan
   Index reoriented_faces = 0;            ///< faces whose orientation disagreed with their component's
   Index cut_edges = 0;                   ///< edges treated as boundaries (non-manifold, orientation conflicts)
   double seconds_curvature = 0, seconds_assembly = 0, seconds_solve = 0, seconds_projection = 0, seconds_guard = 0;
+  double seconds_density = 0;  ///< the density passes, their projection and guard included
   /// Direct: CHOLMOD's analysis and numeric factorisation; iterative: the preconditioner's set-up.
   double seconds_factorization = 0;
   LinearSolver solver_used = LinearSolver::Automatic;  ///< Direct, Iterative or Multilevel (the last solve)
@@ -165,10 +196,11 @@ struct FlowResult {
 };
 
 /// Checks every option against its allowed range: lambda > 0, mu >= 0, epsilon > 0, sliver >= 0
-/// (all finite), d_percentile in [0, 100], iterations >= 1, feature_angle >= 0, max_halvings >= 1,
-/// min_quality and sliver_floor in [0, 1], solver_tolerance in (0, 1), curvature.smoothing_rounds >= 0, and
-/// (when num_vertices >= 0) every pinned index in [0, num_vertices). Throws
-/// std::invalid_argument naming the first option out of range and its allowed range.
+/// (all finite), d_percentile in [0, 100], iterations >= 1, density.passes in [0, 1000],
+/// density.exponent >= 0, density.epsilon > 0, density.step in (0, 1] (all finite), feature_angle >= 0, max_halvings >=
+/// 1, min_quality and sliver_floor in [0, 1], solver_tolerance in (0, 1), curvature.smoothing_rounds >= 0, and (when
+/// num_vertices >= 0) every pinned index in [0, num_vertices). Throws std::invalid_argument naming the first option out
+/// of range and its allowed range.
 void validate_flow_options(const FlowOptions& options, Index num_vertices = -1);
 
 /// Moves the vertices of (V, F) by vertex flow. Throws std::invalid_argument for options out

@@ -343,7 +343,8 @@ def test_stub_lists_every_function_with_the_librarys_defaults():
     V, F = read("spot.obj")
     options = vertexflow.enhance(V, F)[1]["options"]
     library = dict(options, lam=options["lambda"], pins=None, normal_weighting=options["curvature"]["normal_weighting"],
-                   curvature_smoothing_rounds=options["curvature"]["smoothing_rounds"])
+                   curvature_smoothing_rounds=options["curvature"]["smoothing_rounds"],
+                   **{"density_" + k: v for k, v in options["density"].items()})
     for name in vertexflow.FLOW_OPTIONS:
         assert defaults[name] == library[name], name
     # Every keyword of the stub is accepted (a misspelt one raises TypeError).

@@ -3,6 +3,7 @@
 // guard against flipped, degenerate and worsened faces (guard.h).
 #include "vertexflow/flow.h"
 
+#include "density_relaxation.h"
 #include "flow_setup.h"
 #include "flow_solver.h"
 #include "guard.h"
@@ -38,6 +39,11 @@ void validate_flow_options(const FlowOptions& o, Index num_vertices) {
   require(o.sliver_floor >= 0 && o.sliver_floor <= 1, "sliver_floor must be in [0, 1]");
   require(o.solver_tolerance > 0 && o.solver_tolerance < 1, "solver_tolerance must be in (0, 1)");
   require(o.curvature.smoothing_rounds >= 0, "curvature.smoothing_rounds must be >= 0");
+  require(o.density.passes >= 0 && o.density.passes <= 1000, "density.passes must be in [0, 1000]");
+  require(std::isfinite(o.density.exponent) && o.density.exponent >= 0,
+          "density.exponent must be a finite number >= 0");
+  require(std::isfinite(o.density.epsilon) && o.density.epsilon > 0, "density.epsilon must be a finite number > 0");
+  require(std::isfinite(o.density.step) && o.density.step > 0 && o.density.step <= 1, "density.step must be in (0, 1]");
   if (num_vertices < 0) return;
   for (const Index p : o.pinned)
     if (p < 0 || p >= num_vertices)
@@ -110,6 +116,21 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
   FlowSystemSolver solver(topology, fixed, options.solver, options.solver_tolerance);
   const GuardCriteria criteria = guard_criteria(input, F, options.min_quality, options.sliver_floor);
   std::vector<char> shortened(static_cast<std::size_t>(n), 0);
+  std::vector<Index> free_rows;
+  for (Index i = 0; i < n; ++i) {
+    if (!fixed[static_cast<std::size_t>(i)]) free_rows.push_back(i);
+  }
+  // Free vertices onto the surface the flow runs on: S, or the input (features respected).
+  auto project = [&](Vertices& Y) {
+    if (surface) {
+      const std::vector<ClosestPoint> feet = surface->query.closest_points(Y);
+      for (const Index i : free_rows) Y.row(i) = feet[static_cast<std::size_t>(i)].point.transpose();
+    } else {
+      project_near_vertices(Y, free_rows, input, F, topology, setup.features);
+    }
+  };
+  // The surface's curvature at the input positions, for the density passes.
+  Curvature surface_curvature;
   for (int round = 0; round < options.iterations; ++round) {
     const Vertices start_of_round = X;
     // One solve: minimise the energy for positions X, frozen curvature of X.
@@ -117,22 +138,14 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
     const FlowFrame frame = surface
                                 ? flow_frame_on_reference(X, F, topology, options, setup.sliver_faces, *surface, fixed)
                                 : flow_frame(X, F, topology, options, setup.sliver_faces);
+    if (round == 0 && options.density.passes > 0) surface_curvature = frame.curvature;
     report.d = frame.d;
     report.seconds_curvature += seconds_since(start);
     X = solver.solve(frame, options.weights, report);
     if (!X.allFinite()) throw std::runtime_error("vertex flow: the solver diverged");
     if (options.project_to_input) {
       start = Clock::now();
-      std::vector<Index> free_rows;
-      for (Index i = 0; i < n; ++i) {
-        if (!fixed[static_cast<std::size_t>(i)]) free_rows.push_back(i);
-      }
-      if (surface) {
-        const std::vector<ClosestPoint> feet = surface->query.closest_points(X);
-        for (const Index i : free_rows) X.row(i) = feet[static_cast<std::size_t>(i)].point.transpose();
-      } else {
-        project_near_vertices(X, free_rows, input, F, topology, setup.features);
-      }
+      project(X);
       report.seconds_projection += seconds_since(start);
     }
     // Guarded after every round, not only the last: the next round's curvature is estimated on
@@ -141,6 +154,26 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
     start = Clock::now();
     guard(X, start_of_round, input, criteria, fixed, topology, setup.features, guard_options, shortened, report);
     report.seconds_guard += seconds_since(start);
+  }
+
+  if (options.density.passes > 0) {
+    // FlowOptions::density: each pass proposed, projected and guarded as a solve is. Its own
+    // counts: the passes' small steps are shortened far more often than a solve's, and the
+    // guard's before-counts describe the solves.
+    const auto start = Clock::now();
+    const Eigen::VectorXd density = sizing_density(surface_curvature, options.density);
+    std::vector<char> density_shortened(static_cast<std::size_t>(n), 0);
+    FlowReport pass_report;
+    for (int pass = 0; pass < options.density.passes; ++pass) {
+      const Vertices start_of_pass = X;
+      X = density_pass_proposal(X, F, topology, density, free_rows, options.density.step);
+      if (options.project_to_input) project(X);
+      guard(X, start_of_pass, input, criteria, fixed, topology, setup.features, guard_options, density_shortened,
+            pass_report);
+    }
+    report.density_limited_vertices =
+        static_cast<Index>(std::count(density_shortened.begin(), density_shortened.end(), 1));
+    report.seconds_density = seconds_since(start);
   }
 
   report.limited_vertices = static_cast<Index>(std::count(shortened.begin(), shortened.end(), 1));

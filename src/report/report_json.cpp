@@ -67,7 +67,12 @@ void to_json(nlohmann::json& j, const FlowOptions& options) {
             {"sliver_floor", options.sliver_floor},
             {"curvature", options.curvature},
             {"solver", options.solver},
-            {"solver_tolerance", options.solver_tolerance}});
+            {"solver_tolerance", options.solver_tolerance},
+            {"density",
+             {{"passes", options.density.passes},
+              {"exponent", options.density.exponent},
+              {"epsilon", options.density.epsilon},
+              {"step", options.density.step}}}});
 }
 
 void to_json(nlohmann::json& j, const FlowReport& report) {
@@ -81,6 +86,7 @@ void to_json(nlohmann::json& j, const FlowReport& report) {
         {{"faces_bad_before_guard", report.flipped_before_guard},
          {"faces_low_quality_before_guard", report.low_quality_before_guard},
          {"limited_vertices", report.limited_vertices},
+         {"density_limited_vertices", report.density_limited_vertices},
          {"fixed_vertices", report.fixed_vertices}}},
        {"non_manifold",
         {{"held_vertices", report.held_non_manifold_vertices},
@@ -92,7 +98,8 @@ void to_json(nlohmann::json& j, const FlowReport& report) {
          {"solve", report.seconds_solve},
          {"factorization", report.seconds_factorization},
          {"projection", report.seconds_projection},
-         {"guard", report.seconds_guard}}}};
+         {"guard", report.seconds_guard},
+         {"density", report.seconds_density}}}};
 }
 
 void to_json(nlohmann::json& j, const UnsharpOptions& options) {

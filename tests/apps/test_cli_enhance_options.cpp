@@ -89,6 +89,16 @@ TEST(CliEnhanceOptions, IterationsRepeatTheSolve) {
   EXPECT_GT(mean_displacement(mesh, r.V), mean_displacement(mesh, vertex_flow(mesh.V, mesh.F).V));
 }
 
+// --density-passes and --density-exponent reach FlowOptions::density (and change the result);
+// the DensityRelaxation tests measure what the passes do.
+TEST(CliEnhanceOptions, DensityPassesReachTheLibrary) {
+  const Mesh mesh = read_mesh(test::data_path("bunny_uniform.off"));
+  expect_reaches_the_library(mesh, "bunny_uniform.off", "--density-passes 4 --density-exponent 1", [](FlowOptions& o) {
+    o.density.passes = 4;
+    o.density.exponent = 1;
+  });
+}
+
 TEST(CliEnhanceOptions, MinQualityIsTheGuardsFloor) {
   // spot: at the default floor 0.3 some faces end below the floor that 0.5 would set
   // (FlowOptions::min_quality); at --min-quality 0.5 none does.
@@ -164,7 +174,8 @@ TEST(CliEnhanceOptions, ReferenceFitsToTheDenseMesh) {
   EXPECT_EQ(j["fit"]["rms_distance"].size(), expected.report.rms_distance.size());
   const auto& d = j["distance_to_reference"];
   for (const char* key : {"mean", "rms"}) EXPECT_LT(d["result"][key], d["input"][key]) << key;
-  for (const std::string bad : {"--lambda 2", "--no-projection", "--strict", "--method unsharp"}) {
+  for (const std::string bad :
+       {"--lambda 2", "--no-projection", "--strict", "--method unsharp", "--density-passes 3"}) {
     const auto refused =
         test::run_cli("enhance " + test::quoted_data_path("sphere_low.off") + " " + test::quoted(dir.file("x.ply")) +
                       " --reference " + test::quoted(dense_path) + " " + bad);
@@ -269,7 +280,7 @@ TEST(CliEnhanceOptions, SmoothSurfaceFitsTheEstimate) {
   EXPECT_FALSE(j["fit"]["held_as_decimated"]);
   EXPECT_TRUE(j["seconds"].contains("surface"));
   for (const std::string& bad :
-       std::vector<std::string>{"--lambda 2", "--no-projection", "--strict", "--method unsharp",
+       std::vector<std::string>{"--lambda 2", "--no-projection", "--strict", "--method unsharp", "--density-passes 3",
                                 "--reference " + test::quoted_data_path("sphere.off")}) {
     const auto refused = test::run_cli("enhance " + test::quoted_data_path("sphere_low.off") + " " +
                                        test::quoted(dir.file("x.ply")) + " --surface smooth " + bad);

@@ -550,18 +550,27 @@ TEST(FlowProjection, CreaseVerticesStayOnTheirCreasesAndCornersStay) {
   cases.push_back({"fandisk", read_mesh(test::data_path("fandisk.off")), 1});
   cases.push_back({"chamfer-cube", read_mesh(test::data_path("chamfer-cube.off")), 0});
   cases.push_back({"capped elliptic cylinder", capped_elliptic_cylinder(), 1});
-  for (const Case& c : cases) {
-    SCOPED_TRACE(c.name);
-    const Topology topology = build_topology(c.mesh.F, c.mesh.num_vertices());
-    ASSERT_TRUE(topology.is_manifold() && topology.is_closed());
-    const FlowResult result = vertex_flow(c.mesh.V, c.mesh.F);
-    expect_promises_kept(c.mesh, result);
-    const FeatureMotion m = expect_features_kept(c.mesh, result.V);
-    std::cout << "[measured] " << c.name << ": " << m.crease_vertices << " crease vertices, " << m.crease_vertices_moved
-              << " moved, " << m.corners << " corners, worst crease distance " << m.worst_crease_distance
-              << ", worst patch distance " << m.worst_patch_distance << "\n";
-    EXPECT_GE(m.crease_vertices_moved, c.min_crease_moved);
-    EXPECT_LE(m.worst_patch_distance, 0.15);  // measured 0.054 (fandisk), 0.014 (cylinder): the Phong lift
+  // The flow alone, and followed by density passes (FlowOptions::density), which project as
+  // the solve does.
+  for (const int passes : {0, 10}) {
+    FlowOptions options;
+    options.density.passes = passes;
+    for (const Case& c : cases) {
+      SCOPED_TRACE(c.name + ", " + std::to_string(passes) + " density passes");
+      const Topology topology = build_topology(c.mesh.F, c.mesh.num_vertices());
+      ASSERT_TRUE(topology.is_manifold() && topology.is_closed());
+      const FlowResult result = vertex_flow(c.mesh.V, c.mesh.F, options);
+      expect_promises_kept(c.mesh, result);
+      const FeatureMotion m = expect_features_kept(c.mesh, result.V);
+      std::cout << "[measured] " << c.name << ", " << passes << " density passes: " << m.crease_vertices
+                << " crease vertices, " << m.crease_vertices_moved << " moved, " << m.corners
+                << " corners, worst crease distance " << m.worst_crease_distance << ", worst patch distance "
+                << m.worst_patch_distance << "\n";
+      EXPECT_GE(m.crease_vertices_moved, c.min_crease_moved);
+      // Measured 0.054 (fandisk), 0.014 (cylinder) for the flow, 0.063 and 0.021 with passes: the
+      // Phong lift.
+      EXPECT_LE(m.worst_patch_distance, 0.15);
+    }
   }
 }
 
@@ -902,7 +911,9 @@ namespace {
 // 93-182 non-manifold vertices each): the flow runs, keeps its promises, holds the non-manifold
 // vertices bit for bit and redistributes the rest. Measured: rho +0.179, +0.195, +0.153 (input
 // 0.016, 0.006, 0.008); the guard does not limit it (with min_quality 0 it is +0.180, +0.196,
-// +0.155), the energy does: at lambda 0.3 and 2 iterations +0.240, +0.224, +0.191.
+// +0.155), the energy does: at lambda 0.3 and 2 iterations +0.240, +0.224, +0.191. The
+// issue's +0.2 is reached by the density passes (DensityOnClusteredBunny,
+// docs/redistribution.md says why the paper's energy stops short).
 class FlowOnClusteredBunny : public ::testing::TestWithParam<double> {};
 
 TEST_P(FlowOnClusteredBunny, HoldsNonManifoldVerticesAndFlowsTheRest) {

@@ -105,7 +105,7 @@ TEST(CliReport, EnhanceReportHoldsTheFlowsOptionsAndReport) {
                                         "seconds", "provenance"}));
   EXPECT_EQ(report["provenance"], "vertexflow enhance --surface input");  // the line added to OUT (provenance.h)
   EXPECT_EQ(keys(report["seconds"]), (std::set<std::string>{"read", "curvature", "assembly", "solve", "factorization",
-                                                            "projection", "guard", "write"}));
+                                                            "projection", "guard", "density", "write"}));
   const Mesh mesh = read_mesh(input);
   const FlowResult flow = vertex_flow(mesh.V, mesh.F, options);
   const nlohmann::json expected = flow.report;

@@ -65,7 +65,7 @@ TEST(ReportJson, CurvatureOptionsEveryField) {
 TEST(ReportJson, FlowOptionsEveryField) {
   FlowOptions options;
   auto& [weights, d_percentile, iterations, project_to_input, feature_angle, fix_boundary, pinned, refuse_non_manifold,
-         max_halvings, min_quality, sliver_floor, curvature, solver, solver_tolerance] = options;
+         max_halvings, min_quality, sliver_floor, curvature, solver, solver_tolerance, density] = options;
   weights.lambda = 0.25;
   weights.mu = 0.75;
   weights.epsilon = 1e-4;
@@ -85,6 +85,11 @@ TEST(ReportJson, FlowOptionsEveryField) {
   curvature.smoothing_rounds = 1;
   solver = LinearSolver::Multilevel;
   solver_tolerance = 1e-9;
+  auto& [passes, exponent, epsilon, step] = density;
+  passes = 12;
+  exponent = 1.5;
+  epsilon = 0.25;
+  step = 0.75;
   const nlohmann::json j = options;
   // The weights' keys stay at the top level, where the report has always had them.
   EXPECT_EQ(j, nlohmann::json::parse(R"({
@@ -93,23 +98,26 @@ TEST(ReportJson, FlowOptionsEveryField) {
     "fix_boundary": false, "pinned": 3, "refuse_non_manifold": true, "max_halvings": 12, "min_quality": 0.2,
     "sliver_floor": 0.25,
     "curvature": {"normal_weighting": "area", "smoothing_rounds": 1},
-    "solver": "conjugate gradients, multilevel", "solver_tolerance": 1e-9})"));
+    "solver": "conjugate gradients, multilevel", "solver_tolerance": 1e-9,
+    "density": {"passes": 12, "exponent": 1.5, "epsilon": 0.25, "step": 0.75}})"));
   expect_every_value_differs(j, FlowOptions{});
   for (const auto& [key, value] : j["curvature"].items()) EXPECT_NE(value, nlohmann::json(CurvatureOptions{})[key]);
+  for (const auto& [key, value] : j["density"].items()) EXPECT_NE(value, nlohmann::json(FlowOptions{})["density"][key]);
 }
 
 TEST(ReportJson, FlowReportEveryFieldInItsSection) {
   FlowReport report;
   auto& [mean_edge_length, d, solver_error, flipped_before_guard, low_quality_before_guard, limited_vertices,
-         fixed_vertices, held_non_manifold_vertices, reoriented_faces, cut_edges, seconds_curvature, seconds_assembly,
-         seconds_solve, seconds_projection, seconds_guard, seconds_factorization, solver_used, solver_iterations] =
-      report;
+         density_limited_vertices, fixed_vertices, held_non_manifold_vertices, reoriented_faces, cut_edges,
+         seconds_curvature, seconds_assembly, seconds_solve, seconds_projection, seconds_guard, seconds_density,
+         seconds_factorization, solver_used, solver_iterations] = report;
   mean_edge_length = 0.5;
   d = 2.5;
   solver_error = 1e-8;
   flipped_before_guard = 1;
   low_quality_before_guard = 2;
   limited_vertices = 3;
+  density_limited_vertices = 8;
   fixed_vertices = 4;
   held_non_manifold_vertices = 5;
   reoriented_faces = 6;
@@ -119,6 +127,7 @@ TEST(ReportJson, FlowReportEveryFieldInItsSection) {
   seconds_solve = 0.375;
   seconds_projection = 0.5;
   seconds_guard = 0.625;
+  seconds_density = 0.875;
   seconds_factorization = 0.75;
   solver_used = LinearSolver::Direct;
   solver_iterations = 42;
@@ -133,6 +142,7 @@ TEST(ReportJson, FlowReportEveryFieldInItsSection) {
                                     {{"faces_bad_before_guard", 1},
                                      {"faces_low_quality_before_guard", 2},
                                      {"limited_vertices", 3},
+                                     {"density_limited_vertices", 8},
                                      {"fixed_vertices", 4}}},
                                    {"non_manifold", {{"held_vertices", 5}, {"reoriented_faces", 6}, {"cut_edges", 7}}},
                                    {"seconds",
@@ -141,6 +151,7 @@ TEST(ReportJson, FlowReportEveryFieldInItsSection) {
                                      {"solve", 0.375},
                                      {"projection", 0.5},
                                      {"guard", 0.625},
+                                     {"density", 0.875},
                                      {"factorization", 0.75}}}};
   EXPECT_EQ(j, expected);
   const nlohmann::json defaults = FlowReport{};
