@@ -375,9 +375,11 @@ def main():
         fitted_flips, rep_rf = r.enhance(coarse, f"reference-flips-{name}", "--reference", dense, "--edge-flips")
         flowed_on_s, rep_rs = r.enhance(coarse, f"reference-flow-{name}", "--reference", dense, "--reference-method",
                                         "flow")
+        dense_passes, rep_dp = r.enhance(coarse, f"flow-density-{name}", "--density-passes", "30")
         relaxed, seconds_relax = r.relax(coarse, f"relax-{name}")
         variants = [("input", coarse, None), ("paper (flow)", flowed, method_seconds(rep_f)),
                     ("paper + edge flips", flowed_flips, method_seconds(rep_ff)),
+                    ("paper + 30 density passes", dense_passes, method_seconds(rep_dp)),
                     ("smooth", smooth, method_seconds(rep_s)),
                     ("smooth + edge flips", smooth_flips, method_seconds(rep_sf)),
                     ("reference", fitted, method_seconds(rep_r)),
@@ -460,7 +462,9 @@ def main():
            "rho with the dense mesh's curvature; time is the method's own (no I/O), median of the runs. Modes: "
            "`enhance` (the paper's flow, the default), `enhance --surface smooth` (fit to a PN-triangle estimate "
            "through the vertices), `enhance --reference DENSE` (fit to the dense mesh), each also with "
-           "`--edge-flips` (connectivity changes; the time includes the flips); `enhance --reference DENSE "
+           "`--edge-flips` (connectivity changes; the time includes the flips); `enhance --density-passes 30` "
+           "(the flow, then the density-weighted centroidal passes of docs/redistribution.md); "
+           "`enhance --reference DENSE "
            "--reference-method flow` (the paper's flow with the dense mesh as its S: foot points, frames, curvature "
            "and projection from it); CGAL 5.5's "
            "`tangential_relaxation` (3 iterations, `bench/relax_cgal.cpp`) is the same-connectivity peer; "

@@ -24,6 +24,7 @@
 #include <future>
 #include <iostream>
 #include <limits>
+#include <random>
 
 namespace vertexflow {
 namespace {
@@ -601,6 +602,43 @@ TEST(FlowProjection, NoPointJumpsThroughAThinWall) {
   ASSERT_GT(rows.size(), 10u);
   project_near_vertices(queries, rows, slab.V, slab.F, topology, smooth);
   for (const Index v : rows) EXPECT_GT(queries(v, 2), 0.5 * (top + bottom)) << "vertex " << v << " jumped";
+}
+
+// The walk's point-triangle query (its own, not CGAL's: surface_projection.cpp says why) against
+// CGAL's AABB closest points (distance.h) on a flat, irregular grid, where the Phong lift is
+// zero: query points above and below the interior land in faces, points beyond the border on
+// its edges and at its corners, so every region of the query is exercised.
+TEST(FlowProjection, ClosestPointsAgreeWithCgalOnAFlatGrid) {
+  Mesh grid = test::height_field(1.0, 12, [](double, double) { return 0.0; });
+  const Topology topology = build_topology(grid.F, grid.num_vertices());
+  // Jitter the interior vertices in the plane, so faces are not all alike.
+  std::mt19937 random(3);
+  std::uniform_real_distribution<double> jitter(-0.03, 0.03), offset(-0.12, 0.12), height(-0.2, 0.2);
+  for (Index v = 0; v < grid.num_vertices(); ++v)
+    if (!topology.is_boundary_vertex[static_cast<std::size_t>(v)]) {
+      grid.V(v, 0) += jitter(random);
+      grid.V(v, 1) += jitter(random);
+    }
+  const SurfaceFeatures smooth = detect_features(grid.V, grid.F, topology, 180.0);
+  Vertices queries = grid.V;
+  std::vector<Index> rows;
+  Index beyond = 0;
+  for (Index v = 0; v < grid.num_vertices(); ++v) {
+    rows.push_back(v);
+    queries(v, 0) += offset(random);
+    queries(v, 1) += offset(random);
+    queries(v, 2) = height(random);
+    beyond += std::abs(queries(v, 0)) > 1.0 || std::abs(queries(v, 1)) > 1.0;
+  }
+  const std::vector<ClosestPoint> expected = DistanceQuery(grid.V, grid.F).closest_points(queries);
+  project_near_vertices(queries, rows, grid.V, grid.F, topology, smooth);
+  double worst = 0;
+  for (Index v = 0; v < grid.num_vertices(); ++v)
+    worst = std::max(worst, (queries.row(v).transpose() - expected[static_cast<std::size_t>(v)].point).norm());
+  std::cout << "[measured] flat grid: " << rows.size() << " queries, " << beyond
+            << " beyond the border; largest difference from CGAL " << worst << "\n";
+  EXPECT_GT(beyond, 10);
+  EXPECT_LT(worst, 1e-12);
 }
 
 TEST(FlowProjection, VerticesStayOnTheInputSurfaceAndCreasesStayCrisp) {
