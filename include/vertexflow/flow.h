@@ -80,11 +80,15 @@ enum class LinearSolver {
 ///     density(v) = (epsilon + (|k1| + |k2|) * mean edge length)^exponent,
 ///
 /// with the curvature of the surface the flow runs on: the input's, or the reference's at the
-/// foot points), then projects it onto that surface as the solve's result is, and guards the
-/// pass as a solve (FlowOptions::min_quality). Repeated, the passes equalise area times
+/// foot points), then projects it onto that surface as the solve's result is (not with
+/// project_to_input false: then the centroids, inside convex regions, let them shrink), and
+/// guards the pass as a solve (FlowOptions::min_quality). Repeated, the passes equalise area times
 /// density around the vertices (a centroidal Voronoi relaxation on the fixed one-rings), which
 /// puts vertices where the curvature is. exponent 2 asks for edge lengths like 1 / |k|; 0 makes
 /// the passes an area-equalising tangential relaxation (CGAL's tangential_relaxation).
+/// Measured (docs/redistribution.md): 30 passes raise rho by +0.22 to +0.26 on vertex-clustered
+/// bunnies, where the flow alone gives +0.10 to +0.12, and cost 2-12 points of mean distance
+/// to the true surface on remeshed inputs; about 56 ms per pass at 90k vertices and 1.3 s at 1M (docs/benchmarks.md).
 struct DensityRelaxation {
   int passes = 0;         ///< 0: the paper's flow alone
   double exponent = 2.0;  ///< >= 0

@@ -25,6 +25,7 @@ def read(name):
     ("fandisk.off", [], {}),
     ("max-planck-5k.obj", [], {}),
     ("spot.obj", ["--solver", "direct", "--lambda", "0.5"], {"solver": "direct", "lam": 0.5}),
+    ("bunny_uniform.off", ["--density-passes", "5"], {"density_passes": 5}),
 ])
 def test_enhance_matches_cli_bit_for_bit(tmp_path, name, cli_args, kwargs):
     out = tmp_path / "cli.ply"  # PLY keeps float64 exactly
