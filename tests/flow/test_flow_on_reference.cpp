@@ -80,7 +80,7 @@ TEST(FlowOnReference, InvariantAndDeterministic) {
 // stay bit for bit, the others end on bunny.off, and the promises hold.
 TEST(FlowOnReference, NonManifoldMeshFlowsWithItsNonManifoldVerticesHeld) {
   const Mesh dense = read_mesh(test::data_path("bunny.off"));
-  const Mesh coarse = test::vertex_clustered(dense, 0.02 * bounding_box(dense.V).diagonal());
+  const Mesh coarse = test::clustered_bunny(0.02);
   const Topology topology = build_topology(coarse.F, coarse.num_vertices());
   ASSERT_FALSE(topology.is_manifold());
   const FlowResult result = vertex_flow_on_reference(coarse.V, coarse.F, dense.V, dense.F);

@@ -1,5 +1,9 @@
 #include "test_support.h"
 
+#include "shapes.h"
+#include "vertexflow/compare.h"
+#include "vertexflow/io.h"
+#include "vertexflow/manifold_split.h"
 #include "vertexflow/quality.h"
 #include "vertexflow/topology.h"
 
@@ -182,6 +186,25 @@ void expect_same_topology(const Mesh& input, const Mesh& output) {
   EXPECT_EQ(after.genus(), before.genus());
   EXPECT_EQ(after.num_components, before.num_components);
   EXPECT_EQ(after.boundary_loops.size(), before.boundary_loops.size());
+}
+
+Mesh clustered_bunny(double fraction) {
+  const Mesh bunny = read_mesh(data_path("bunny.off"));
+  return vertex_clustered(bunny, fraction * bounding_box(bunny.V).diagonal());
+}
+
+RhoChange redistribution_rho_change(const Mesh& input, const Vertices& moved) {
+  const ManifoldSplit split = split_non_manifold(input.V, input.F, build_topology(input.F, input.num_vertices()));
+  Mesh before;
+  before.V = split.V;
+  before.F = split.F;
+  Mesh after = before;
+  for (Index s = 0; s < split.V.rows(); ++s)
+    after.V.row(s) = moved.row(split.source_vertex[static_cast<std::size_t>(s)]);
+  CompareOptions options;
+  options.sampling.samples = 1000;
+  const MeshComparison c = compare_meshes(after, before, nullptr, options);
+  return {c.redistribution_rho_input, c.redistribution_rho_result};
 }
 
 }  // namespace vertexflow::test

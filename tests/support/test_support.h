@@ -118,4 +118,18 @@ Eigen::VectorXd stated_quality_floor(const Mesh& input, double min_quality, doub
 /// The whole content of a file (empty if it cannot be read).
 std::string read_text(const std::filesystem::path& path);
 
+/// bunny.off (data/) vertex-clustered with cells of `fraction` of its bounding-box diagonal
+/// (shapes.h, vertex_clustered): how the Stanford low-resolution scans were made, non-manifold.
+Mesh clustered_bunny(double fraction);
+
+/// The redistribution rho (docs/metrics.md: the input's curvature) of `input` and of its
+/// vertices moved to `moved`, as compare_meshes reports it (1,000 samples: only rho is used).
+/// A non-manifold or misoriented input is measured on its manifold split (manifold_split.h):
+/// the same surface, the one the flow ran on.
+struct RhoChange {
+  double before = 0, after = 0;
+  [[nodiscard]] double gain() const { return after - before; }
+};
+RhoChange redistribution_rho_change(const Mesh& input, const Vertices& moved);
+
 }  // namespace vertexflow::test
