@@ -61,15 +61,16 @@ class TemporaryRegistry {
  public:
   static constexpr int kNone = -1;
 
-  // Reserves a slot for the file `name` before it is created; kNone if every slot is busy or
+  // Reserves a slot for the file at `path` before it is created; kNone if every slot is busy or
   // the path is too long, and then the file is simply not protected. Call under a FillingGuard
   // and arm() or release() the slot before the guard ends.
-  static int reserve(const std::string& name) {
-    install_handlers();
-    // Absolute, in case the working directory changes before a signal comes.
-    std::error_code ec;
-    const std::string path = std::filesystem::absolute(name, ec).string();
-    if (ec || path.size() >= sizeof(TemporarySlot::path)) return kNone;
+  //
+  // `path` is absolute_path(name), computed before: from reserve() to arm() or release() the
+  // slot is Filling, and the handler on another thread waits for it, so nothing in between may
+  // take a lock that handler's thread could hold (malloc's, when the signal interrupted it).
+  // Only a copy and a system call come in between.
+  static int reserve(const std::string& path) {
+    if (path.empty() || path.size() >= sizeof(TemporarySlot::path)) return kNone;
     for (std::size_t i = 0; i < temporary_slots.size(); ++i) {
       int expected = kFree;
       if (temporary_slots[i].state.compare_exchange_strong(expected, kFilling)) {
@@ -78,6 +79,14 @@ class TemporaryRegistry {
       }
     }
     return kNone;
+  }
+  // `name` made absolute, in case the working directory changes before a signal comes (empty
+  // if it cannot be); installs the handlers on first use.
+  static std::string absolute_path(const std::string& name) {
+    install_handlers();
+    std::error_code ec;
+    std::string path = std::filesystem::absolute(name, ec).string();
+    return ec ? std::string() : path;
   }
   // The file now exists. Only from here may the handler unlink the path: before, it could name
   // someone else's file (the O_EXCL or linkat that reports EEXIST).
@@ -186,9 +195,10 @@ class AtomicFile {
       {
         // SIGINT and SIGTERM wait in this thread while the file is created and armed: a signal
         // between the two left the file behind (seen once in CI, killed as the write began).
-        const FillingGuard guard;
         temp_ = random_hidden_name(target_);
-        slot_ = TemporaryRegistry::reserve(temp_);
+        const std::string absolute = TemporaryRegistry::absolute_path(temp_);
+        const FillingGuard guard;
+        slot_ = TemporaryRegistry::reserve(absolute);
         fd_ = ::open(temp_.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0666);
         error = errno;
         if (fd_ >= 0) {
@@ -248,9 +258,10 @@ class AtomicFile {
   void link_unnamed() {
     const std::string proc = "/proc/self/fd/" + std::to_string(fd_);
     for (int attempt = 0; attempt < 100; ++attempt) {
-      const FillingGuard guard;  // as in the constructor: no signal between linkat and arm
       std::string name = random_hidden_name(target_);
-      slot_ = TemporaryRegistry::reserve(name);
+      const std::string absolute = TemporaryRegistry::absolute_path(name);
+      const FillingGuard guard;  // as in the constructor: no signal between linkat and arm
+      slot_ = TemporaryRegistry::reserve(absolute);
       if (::linkat(AT_FDCWD, proc.c_str(), AT_FDCWD, name.c_str(), AT_SYMLINK_FOLLOW) == 0) {
         TemporaryRegistry::arm(slot_);
         temp_ = std::move(name);
