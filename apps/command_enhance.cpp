@@ -183,6 +183,9 @@ MethodRun run_flow(const Mesh& mesh, const Topology& topology, const FlowOptions
       "limited by the guard",
       r.seconds_curvature, r.seconds_assembly, r.seconds_solve, r.seconds_projection, r.seconds_guard,
       r.limited_vertices));
+  if (options.density.passes > 0)
+    phase(fmt::format("{} density passes {:.3f} s; {} vertices limited by their guard", options.density.passes,
+                      r.seconds_density, r.density_limited_vertices));
   warn_about_split({r.held_non_manifold_vertices, r.reoriented_faces, r.cut_edges}, warn);
   MethodRun run;
   run.report = r;

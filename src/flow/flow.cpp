@@ -44,6 +44,8 @@ void validate_flow_options(const FlowOptions& o, Index num_vertices) {
           "density.exponent must be a finite number >= 0");
   require(std::isfinite(o.density.epsilon) && o.density.epsilon > 0, "density.epsilon must be a finite number > 0");
   require(std::isfinite(o.density.step) && o.density.step > 0 && o.density.step <= 1, "density.step must be in (0, 1]");
+  require(o.density.passes == 0 || o.project_to_input,
+          "density passes need the projection (project_to_input): unprojected, the centroids shrink the mesh");
   if (num_vertices < 0) return;
   for (const Index p : o.pinned)
     if (p < 0 || p >= num_vertices)
@@ -121,12 +123,12 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
     if (!fixed[static_cast<std::size_t>(i)]) free_rows.push_back(i);
   }
   // Free vertices onto the surface the flow runs on: S, or the input (features respected).
-  auto project = [&](Vertices& Y) {
+  auto project = [&](Vertices& Y, const std::vector<Index>& rows) {
     if (surface) {
       const std::vector<ClosestPoint> feet = surface->query.closest_points(Y);
-      for (const Index i : free_rows) Y.row(i) = feet[static_cast<std::size_t>(i)].point.transpose();
+      for (const Index i : rows) Y.row(i) = feet[static_cast<std::size_t>(i)].point.transpose();
     } else {
-      project_near_vertices(Y, free_rows, input, F, topology, setup.features);
+      project_near_vertices(Y, rows, input, F, topology, setup.features);
     }
   };
   // The surface's curvature at the input positions, for the density passes.
@@ -145,7 +147,7 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
     if (!X.allFinite()) throw std::runtime_error("vertex flow: the solver diverged");
     if (options.project_to_input) {
       start = Clock::now();
-      project(X);
+      project(X, free_rows);
       report.seconds_projection += seconds_since(start);
     }
     // Guarded after every round, not only the last: the next round's curvature is estimated on
@@ -164,10 +166,15 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
     const Eigen::VectorXd density = sizing_density(surface_curvature, options.density);
     std::vector<char> density_shortened(static_cast<std::size_t>(n), 0);
     FlowReport pass_report;
+    // Free boundary vertices (fix_boundary false) stay where the solve put them: their centroid
+    // lies inside the surface, and nothing would hold them on the boundary line.
+    std::vector<Index> interior_rows;
+    for (const Index i : free_rows)
+      if (!topology.is_boundary_vertex[static_cast<std::size_t>(i)]) interior_rows.push_back(i);
     for (int pass = 0; pass < options.density.passes; ++pass) {
       const Vertices start_of_pass = X;
-      X = density_pass_proposal(X, F, topology, density, free_rows, options.density.step);
-      if (options.project_to_input) project(X);
+      X = density_pass_proposal(X, F, topology, density, interior_rows, options.density.step);
+      project(X, interior_rows);  // only the moved rows: the Phong lift is not idempotent
       guard(X, start_of_pass, input, criteria, fixed, topology, setup.features, guard_options, density_shortened,
             pass_report);
     }

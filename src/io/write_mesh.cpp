@@ -112,8 +112,11 @@ class TemporaryRegistry {
       // this is another thread: wait the few microseconds until its open() or linkat() has
       // returned and the slot is Armed or Free. Skipping it left the file behind (seen in CI:
       // SIGTERM delivered to a worker thread while the main thread was inside linkat()).
+      // Bounded (about 0.1 s), so that a slot left Filling for good (a thread stuck in open() on
+      // a hung file system, or a fork() child that inherited another thread's slot) cannot make
+      // the process ignore the signal; such a file is left behind, as after SIGKILL.
       int state = slot.state.load();
-      while (state == kFilling) {
+      for (int wait = 0; state == kFilling && wait < 1000; ++wait) {
         const timespec pause{0, 100'000};
         ::nanosleep(&pause, nullptr);  // async-signal-safe
         state = slot.state.load();

@@ -141,6 +141,33 @@ TEST(DensityRelaxation, RefusesOptionsOutOfRange) {
   refused([](DensityRelaxation& d) { d.epsilon = 0; });
   refused([](DensityRelaxation& d) { d.step = 0; });
   refused([](DensityRelaxation& d) { d.step = 1.5; });
+  FlowOptions unprojected = with_passes(5);
+  unprojected.project_to_input = false;
+  EXPECT_THROW(vertex_flow(sphere.V, sphere.F, unprojected), std::invalid_argument);
+}
+
+// A free boundary (fix_boundary false) moves in the solve but not in the passes, whose
+// centroids would pull it inwards: hemisphere.off's rim ends where the flow alone puts it.
+TEST(DensityRelaxation, LeavesAFreeBoundaryWhereTheSolvePutIt) {
+  const Mesh hemisphere = read_mesh(test::data_path("hemisphere.off"));
+  const Topology topology = build_topology(hemisphere.F, hemisphere.num_vertices());
+  FlowOptions free = with_passes(10);
+  free.fix_boundary = false;
+  const FlowResult passes = vertex_flow(hemisphere.V, hemisphere.F, free);
+  free.density.passes = 0;
+  const FlowResult flow = vertex_flow(hemisphere.V, hemisphere.F, free);
+  Index rim = 0, rim_moved_by_solve = 0;
+  for (Index v = 0; v < hemisphere.num_vertices(); ++v) {
+    if (!topology.is_boundary_vertex[static_cast<std::size_t>(v)]) continue;
+    ++rim;
+    rim_moved_by_solve += flow.V.row(v) != hemisphere.V.row(v);
+    EXPECT_EQ(passes.V.row(v), flow.V.row(v)) << "rim vertex " << v;
+  }
+  const double interior_moved = (passes.V - flow.V).rowwise().norm().sum() / passes.report.mean_edge_length;
+  std::cout << "[measured] hemisphere, free boundary: " << rim << " rim vertices, " << rim_moved_by_solve
+            << " moved by the solve; the passes move the rest by " << interior_moved << " edge lengths in all\n";
+  EXPECT_GT(rim_moved_by_solve, 0);  // the boundary is free
+  EXPECT_GT(interior_moved, 20.0);   // measured 223 over the hemisphere's interior
 }
 
 }  // namespace

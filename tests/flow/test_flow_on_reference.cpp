@@ -108,6 +108,28 @@ TEST(FlowOnReference, NonManifoldMeshFlowsWithItsNonManifoldVerticesHeld) {
   EXPECT_GT(before.mean(), 1e-4);
   EXPECT_GE(on_s, free - result.report.limited_vertices);
   EXPECT_LT(after.mean(), 0.5 * before.mean());  // measured 8.4e-5, 0.26 of the input's
+  // With density passes (FlowOptions::density) the free vertices still end on S, the held ones
+  // stay, and the redistribution by S's curvature goes further.
+  FlowOptions passes;
+  passes.density.passes = 10;
+  const FlowResult denser = vertex_flow_on_reference(coarse.V, coarse.F, dense.V, dense.F, passes);
+  test::expect_guard_promises_kept(coarse, denser.V, true, {}, 0.3, 0.5);
+  for (const Index v : topology.non_manifold_vertices) ASSERT_EQ(denser.V.row(v), coarse.V.row(v)) << v;
+  const Eigen::VectorXd denser_after = distances(denser.V, dense) / diagonal;
+  const Index denser_on_s = (denser_after.array() < 1e-6).count();
+  CompareOptions compare;
+  compare.sampling.samples = 1000;  // only rho is used
+  auto rho_on_s = [&](const Vertices& X) {
+    Mesh moved = coarse;
+    moved.V = X;
+    return compare_meshes(moved, coarse, &dense, compare).redistribution_rho_result;
+  };
+  const double rho_flow = rho_on_s(result.V), rho_passes = rho_on_s(denser.V);
+  std::cout << "[measured] with 10 density passes: " << denser_on_s << " on S (" << denser.report.limited_vertices
+            << " + " << denser.report.density_limited_vertices << " limited); rho by S's curvature " << rho_flow
+            << " -> " << rho_passes << "\n";
+  EXPECT_GE(denser_on_s, free - denser.report.limited_vertices - denser.report.density_limited_vertices);
+  EXPECT_GT(rho_passes, rho_flow + 0.02);  // measured 0.233 -> 0.298
   // With refuse_non_manifold the reference flow refuses as vertex_flow does.
   FlowOptions strict;
   strict.refuse_non_manifold = true;

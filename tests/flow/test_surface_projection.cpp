@@ -1,7 +1,7 @@
 // Feature detection of the flow's projection (src/flow/surface_projection.h): which sharp edges
 // are creases, which vertices are corners.
-#include "vertexflow/features.h"
 #include "test_support.h"
+#include "vertexflow/features.h"
 
 #include "vertexflow/io.h"
 #include "vertexflow/topology.h"
