@@ -1,5 +1,6 @@
 // What the headless-Chromium tests share: their command line (--cli, --data, --work,
-// --chromium), one line per check, and the closing "N passed, M failed" with its exit code.
+// --chromium), a page that may not leave file://, one line per check, and the closing
+// "N passed, M failed" with its exit code.
 import { mkdirSync, rmSync } from 'node:fs';
 
 /// Parses the common options; prints `usage` and exits 2 when --cli, --data or --work is missing.
@@ -24,6 +25,27 @@ export function testSetup(usage) {
   rmSync(setup.work, { recursive: true, force: true });
   mkdirSync(setup.work, { recursive: true });
   return setup;
+}
+
+/// A new context of `browser` with `viewport` and a page in it. Every request other than file:// is
+/// refused and recorded in `requests`; console errors and page errors are recorded in `errors`.
+/// The caller checks both and closes `context`.
+export async function offlinePage(browser, viewport) {
+  const context = await browser.newContext({ viewport });
+  const requests = [];
+  await context.route('**/*', (route) => {
+    const url = route.request().url();
+    if (url.startsWith('file:')) return route.continue();
+    requests.push(url);
+    return route.abort();
+  });
+  const page = await context.newPage();
+  const errors = [];
+  page.on('console', (message) => {
+    if (message.type() === 'error') errors.push(message.text());
+  });
+  page.on('pageerror', (error) => errors.push(error.message));
+  return { context, page, requests, errors };
 }
 
 let passed = 0;

@@ -12,7 +12,7 @@ import { execFileSync } from 'node:child_process';
 import path from 'node:path';
 import { pathToFileURL } from 'node:url';
 import { chromium } from 'playwright-core';
-import { check, finish, testSetup } from './harness.mjs';
+import { check, finish, offlinePage, testSetup } from './harness.mjs';
 
 const { cli, dataDir, work, executablePath } = testSetup(
   'lines_browser.mjs --cli VERTEXFLOW --data DATA_DIR --work DIR [--chromium PATH]');
@@ -49,20 +49,7 @@ const browser = await chromium.launch({
   args: ['--no-sandbox', '--disable-dev-shm-usage'],
 });
 try {
-  const context = await browser.newContext({ viewport: { width: 800, height: 600 } });
-  const requests = [];
-  await context.route('**/*', (route) => {
-    const url = route.request().url();
-    if (url.startsWith('file:')) return route.continue();
-    requests.push(url);
-    return route.abort();
-  });
-  const page = await context.newPage();
-  const errors = [];
-  page.on('console', (message) => {
-    if (message.type() === 'error') errors.push(message.text());
-  });
-  page.on('pageerror', (error) => errors.push(error.message));
+  const { context, page, requests, errors } = await offlinePage(browser, { width: 800, height: 600 });
   const response = await page.goto(pathToFileURL(svg).href);
   check(response !== null && response.ok(), 'the SVG loads');
   const groups = await page.evaluate(() =>

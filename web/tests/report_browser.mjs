@@ -15,7 +15,7 @@ import { statSync } from 'node:fs';
 import path from 'node:path';
 import { pathToFileURL } from 'node:url';
 import { chromium } from 'playwright-core';
-import { check, finish, testSetup } from './harness.mjs';
+import { check, finish, offlinePage, testSetup } from './harness.mjs';
 
 const { args, cli, dataDir, work, executablePath } = testSetup(
   'report_browser.mjs --cli VERTEXFLOW --data DATA_DIR --work DIR [--chromium PATH] [--shots]');
@@ -95,20 +95,7 @@ const VIEWS = ['input', 'result'];
 
 async function testReport(browser, file, { decimated, interact }) {
   const name = path.basename(file);
-  const context = await browser.newContext({ viewport: { width: 900, height: 700 } });
-  const requests = [];
-  await context.route('**/*', (route) => {
-    const url = route.request().url();
-    if (url.startsWith('file:')) return route.continue();
-    requests.push(url);
-    return route.abort();
-  });
-  const page = await context.newPage();
-  const errors = [];
-  page.on('console', (message) => {
-    if (message.type() === 'error') errors.push(message.text());
-  });
-  page.on('pageerror', (error) => errors.push(error.message));
+  const { context, page, requests, errors } = await offlinePage(browser, { width: 900, height: 700 });
 
   const start = Date.now();
   await page.goto(pathToFileURL(file).href);
