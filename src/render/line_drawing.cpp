@@ -9,7 +9,9 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstring>
 #include <memory>
 #include <stdexcept>
@@ -18,23 +20,24 @@ namespace vertexflow {
 namespace {
 
 struct Style {
-  const char* color;          // SVG colour
-  std::array<double, 3> rgb;  // the same for cairo
-  double width;               // times the line width
+  std::array<std::uint8_t, 3> rgb;
+  double width;  // times the line width
+  [[nodiscard]] std::string svg_color() const { return fmt::format("#{:02x}{:02x}{:02x}", rgb[0], rgb[1], rgb[2]); }
+  [[nodiscard]] double channel(int c) const { return rgb[static_cast<std::size_t>(c)] / 255.0; }  // cairo's
 };
 
 Style style_of(LineType type) {
   switch (type) {
     case LineType::Contour:
-      return {"#000000", {0, 0, 0}, 1.0};
+      return {{0, 0, 0}, 1.0};
     case LineType::SuggestiveContour:
-      return {"#000000", {0, 0, 0}, 0.75};
+      return {{0, 0, 0}, 0.75};
     case LineType::Ridge:
-      return {"#a02818", {0xa0 / 255.0, 0x28 / 255.0, 0x18 / 255.0}, 0.75};
+      return {{0xa0, 0x28, 0x18}, 0.75};
     case LineType::Valley:
-      return {"#1840a0", {0x18 / 255.0, 0x40 / 255.0, 0xa0 / 255.0}, 0.75};
+      return {{0x18, 0x40, 0xa0}, 0.75};
   }
-  return {"#000000", {0, 0, 0}, 1.0};
+  return {{0, 0, 0}, 1.0};
 }
 
 // The farthest surface depth among the 3 x 3 pixels around (x, y) (line_drawing.h says why);
@@ -164,7 +167,7 @@ std::string svg_document(const LineDrawing& drawing, double line_width) {
     svg += fmt::format(
         "<g id=\"{}\" fill=\"none\" stroke=\"{}\" stroke-width=\"{:.3g}\" stroke-linecap=\"round\" "
         "stroke-linejoin=\"round\">\n",
-        line_type_name(type), style.color, style.width * line_width);
+        line_type_name(type), style.svg_color(), style.width * line_width);
     for (const ImagePolyline& line : drawing.lines) {
       if (line.type != type) continue;
       svg += "<polyline points=\"";
@@ -210,7 +213,7 @@ Image line_image(const LineDrawing& drawing, double line_width, const Image& und
   cairo_set_line_join(cr.get(), CAIRO_LINE_JOIN_ROUND);
   for (const ImagePolyline& line : drawing.lines) {
     const Style style = style_of(line.type);
-    cairo_set_source_rgb(cr.get(), style.rgb[0], style.rgb[1], style.rgb[2]);
+    cairo_set_source_rgb(cr.get(), style.channel(0), style.channel(1), style.channel(2));
     cairo_set_line_width(cr.get(), style.width * line_width);
     cairo_move_to(cr.get(), line.points[0].x(), line.points[0].y());
     for (std::size_t i = 1; i < line.points.size(); ++i)
