@@ -88,8 +88,11 @@ enum class LinearSolver {
 /// (validate_flow_options): unprojected, centroids inside convex regions shrink the mesh.
 /// Repeated, the passes equalise area times density around the vertices (a centroidal Voronoi
 /// relaxation on the fixed one-rings), which puts vertices where the curvature is. exponent 2
-/// asks for edge lengths like 1 / |k|; 0 makes the passes an area-equalising tangential
-/// relaxation (like CGAL's tangential_relaxation).
+/// asks for edge lengths like 1 / |k|, which the +0.2 rho of issue 15 needs; a uniform edge
+/// error (the paper's objective) asks for 1 / sqrt(|k|), exponent 1, and at sharp CAD creases
+/// exponent 2 overshoots it (fandisk's edge-error CV: +46% with 30 passes, -19% at exponent
+/// 1). 0 makes the passes an area-equalising tangential relaxation (like CGAL's
+/// tangential_relaxation).
 ///
 /// Measured (docs/redistribution.md): 30 passes raise rho by +0.22 to +0.26 on vertex-clustered
 /// bunnies, where the flow alone gives +0.10 to +0.12. Like the flow, they slide vertices over
