@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <map>
 #include <system_error>
@@ -87,14 +88,6 @@ std::string describe_format(const ReadReport& report) {
   return s;
 }
 
-nlohmann::json to_json(const QualityStats& stats) {
-  return {{"min", stats.min},
-          {"mean", stats.mean},
-          {"p5", stats.p5},
-          {"fraction_below_0_3", stats.fraction_below_0_3},
-          {"histogram", stats.histogram}};
-}
-
 nlohmann::json to_json(const SurfaceRepairs& repairs) {
   return {{"input_split_vertices", repairs.input_split.held_vertices},
           {"input_reoriented_faces", repairs.input_split.reversed_faces},
@@ -118,69 +111,61 @@ void warn_about_repairs(const std::string& input, const SurfaceRepairs& repairs,
                input, repairs.removed_degenerate_faces, repairs.duplicated_vertices);
 }
 
-void add_flow_options(CLI::App* command, FlowOptions& flow, bool& no_projection) {
-  command
-      ->add_option("--lambda", flow.weights.lambda,
-                   "Weight of the distance to the input: smaller moves vertices further (0.2 strong .. 50 faint)")
-      ->check(CLI::PositiveNumber)
-      ->capture_default_str();
-  command->add_option("--mu", flow.weights.mu, "Weight of the fairness term")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  command->add_option("--iterations", flow.iterations, "Solves, curvature recomputed in between")
-      ->check(CLI::Range(1, 20))
-      ->capture_default_str();
-  command
-      ->add_option("--min-quality", flow.min_quality,
-                   "Guard: no face ends below min(this, the worst input radius ratio 2r/R around its corners); "
-                   "0 repairs only flips")
-      ->check(CLI::Range(0.0, 1.0))
-      ->capture_default_str();
-  command
-      ->add_option("--sliver-floor", flow.sliver_floor,
-                   "Guard: a face starting below --min-quality may not fall below this fraction of its input ratio")
-      ->check(CLI::Range(0.0, 1.0))
-      ->capture_default_str();
-  command
-      ->add_option("--sliver-stiffness", flow.weights.sliver,
-                   "Weight of the solve's term that keeps corners of faces below --min-quality from their opposite "
-                   "edges (0: the guard alone)")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  command
-      ->add_option("--density-passes", flow.density.passes,
-                   "Density-weighted centroidal passes after the solve, which move vertices towards curvature where "
-                   "the mesh's connectivity holds the flow back (vertex-clustered scans); 0: the paper's flow alone "
-                   "(flow.h, DensityRelaxation)")
-      ->check(CLI::Range(0, 1000))
-      ->capture_default_str();
-  command
-      ->add_option("--density-exponent", flow.density.exponent,
-                   "Density passes: sizing density (0.1 + (|k1| + |k2|) * mean edge length)^this; 0 equalises areas")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  command->add_flag("--no-projection", no_projection,
-                    "Leave vertices where the solve puts them instead of moving them onto the input surface");
-  command
-      ->add_option("--fairness", flow.weights.fairness_target,
-                   "Target of the fairness term: input-normal (default; keeps the shape) or zero (the paper's)")
-      ->transform(
-          CLI::CheckedTransformer(std::map<std::string, FairnessTarget>{{"input-normal", FairnessTarget::InputNormal},
-                                                                        {"zero", FairnessTarget::Zero}},
-                                  CLI::ignore_case));
-  command
-      ->add_option("--feature-angle", flow.feature_angle,
-                   "Dihedral angle (degrees) above which an edge is a crease vertices slide along, not across")
-      ->check(CLI::NonNegativeNumber)
-      ->capture_default_str();
-  command
-      ->add_option("--solver", flow.solver,
-                   "Linear solver: automatic (default; flow.h says how it chooses), direct, iterative or multilevel")
-      ->transform(CLI::CheckedTransformer(std::map<std::string, LinearSolver>{{"automatic", LinearSolver::Automatic},
-                                                                              {"direct", LinearSolver::Direct},
-                                                                              {"iterative", LinearSolver::Iterative},
-                                                                              {"multilevel", LinearSolver::Multilevel}},
-                                          CLI::ignore_case));
+void add_enhance_options(CLI::App* command, GivenOptions& given, std::initializer_list<std::string_view> skip) {
+  static const EnhanceOptions defaults;
+  for (const EnhanceOptionSpec& spec : enhance_option_specs()) {
+    if (spec.flag.empty() || std::find(skip.begin(), skip.end(), spec.name) != skip.end()) continue;
+    const std::string flag(spec.flag), help(spec.help);
+    // Each value is range-checked as it is parsed, in the table's words (one line, exit 1).
+    const auto store = [&given, &spec](OptionValue value) {
+      check_option_value(spec, value, OptionNaming::Cli);
+      given[std::string(spec.name)] = std::move(value);
+    };
+    CLI::Option* option = nullptr;
+    switch (spec.kind) {
+      case OptionKind::Bool: {
+        const bool value = !spec.flag_negates;
+        command->add_flag_callback(
+            flag, [store, value] { store(value); }, help);
+        continue;
+      }
+      case OptionKind::Int:
+      case OptionKind::OptionalInt:
+        option = command->add_option_function<long long>(
+            flag, [store](const long long& v) { store(v); }, help);
+        break;
+      case OptionKind::Double:
+        option = command->add_option_function<double>(
+            flag, [store](const double& v) { store(v); }, help);
+        break;
+      case OptionKind::Choice:
+        option = command->add_option_function<std::string>(
+            flag, [store](const std::string& v) { store(v); }, help);
+        break;
+      case OptionKind::Indices:
+        continue;  // no flag (--pin FILE reads them)
+    }
+    const OptionValue fallback = spec.get(defaults);
+    if (!std::holds_alternative<std::monostate>(fallback)) {
+      std::string text = python_literal(fallback);
+      if (spec.kind == OptionKind::Choice) text = std::get<std::string>(fallback);
+      option->default_str(text);
+    }
+  }
+}
+
+HtmlReportOptions html_report_options(const std::filesystem::path& input, const std::filesystem::path& result) {
+  HtmlReportOptions options;
+  options.input_label = input.filename().string();
+  options.result_label = result.filename().string();
+  options.title = "vertexflow: " + options.input_label + " and " + options.result_label;
+  return options;
+}
+
+EnhanceOptions enhance_options_from(const GivenOptions& given) {
+  EnhanceOptions options;
+  for (const auto& [name, value] : given) find_enhance_option(name)->set(options, value);
+  return options;
 }
 
 nlohmann::json to_json(const MeshInfo& info) {
@@ -202,7 +187,7 @@ nlohmann::json to_json(const MeshInfo& info) {
       {"closed", info.closed},
       {"non_manifold_edges", info.non_manifold_edges},
       {"non_manifold_vertices", info.non_manifold_vertices},
-      {"quality", to_json(info.quality)}};
+      {"quality", nlohmann::json(info.quality)}};
 }
 
 nlohmann::json to_json(const ReadReport& report) {
@@ -215,16 +200,6 @@ nlohmann::json to_json(const ReadReport& report) {
           {"repeated_index_faces_removed", report.repeated_index_faces_removed},
           {"duplicate_faces_removed", report.duplicate_faces_removed},
           {"zero_area_faces_removed", report.zero_area_faces_removed}};
-}
-
-nlohmann::json to_json(const DistanceStats& stats, double length_scale) {
-  return {{"mean", stats.mean},
-          {"rms", stats.rms},
-          {"max", stats.max},
-          {"mean_relative", stats.mean / length_scale},
-          {"rms_relative", stats.rms / length_scale},
-          {"max_relative", stats.max / length_scale},
-          {"points", stats.points}};
 }
 
 }  // namespace vertexflow::cli

@@ -2,15 +2,19 @@
 #pragma once
 
 #include "vertexflow/distance.h"
-#include "vertexflow/flow.h"
+#include "vertexflow/enhance_options.h"
+#include "vertexflow/html_report.h"
 #include "vertexflow/io.h"
 #include "vertexflow/manifold_split.h"
 #include "vertexflow/mesh_info.h"
+#include "vertexflow/report_json.h"
 
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
 #include <filesystem>
+#include <initializer_list>
+#include <map>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -57,21 +61,26 @@ bool names_an_input(std::string_view message);
 std::string describe_format(const ReadReport& report);
 
 nlohmann::json to_json(const MeshInfo& info);
-nlohmann::json to_json(const QualityStats& stats);
 nlohmann::json to_json(const SurfaceRepairs& repairs);
 
 /// Prints (unless quiet) one warning line per kind of repair remesh or simplify made to `input`
 /// or to their result (manifold_split.h).
 void warn_about_repairs(const std::string& input, const SurfaceRepairs& repairs, const GlobalOptions& global);
 nlohmann::json to_json(const ReadReport& report);
-/// mean, rms, max (absolute), the same divided by `length_scale` (*_relative), and points.
-nlohmann::json to_json(const DistanceStats& stats, double length_scale);
 
-/// Registers the options of the flow that `enhance` and `batch` share: --lambda, --mu,
-/// --iterations, --min-quality, --sliver-floor, --sliver-stiffness, --no-projection (into
-/// `no_projection`; the caller sets flow.project_to_input from it), --fairness, --feature-angle
-/// and --solver.
-void add_flow_options(CLI::App* command, FlowOptions& flow, bool& no_projection);
+/// The enhance options given on a command line, by their Python names (enhance_options.h).
+using GivenOptions = std::map<std::string, OptionValue, std::less<>>;
+
+/// Registers one flag per option of enhance_options.h's table that has one (but those named in
+/// `skip`), as `enhance` and `batch` share them: each value is checked against the table's
+/// range as it is parsed (std::invalid_argument naming the flag) and stored in `given`.
+void add_enhance_options(CLI::App* command, GivenOptions& given, std::initializer_list<std::string_view> skip = {});
+
+/// EnhanceOptions with the given values set (the rest at their defaults).
+EnhanceOptions enhance_options_from(const GivenOptions& given);
+
+/// HTML report options whose title and labels name the two mesh files.
+HtmlReportOptions html_report_options(const std::filesystem::path& input, const std::filesystem::path& result);
 
 /// Registers the subcommands (one function per command file).
 void register_info_command(CLI::App& app, const GlobalOptions& global);

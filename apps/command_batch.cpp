@@ -1,11 +1,13 @@
-// `vertexflow batch IN OUT_DIR [...]`: `enhance` over every mesh of a directory or glob, with
-// --jobs files at once, a progress bar with an ETA, resumable, and a summary table
-// (command_batch_core.h).
+// `vertexflow batch IN OUT_DIR [...]`: `enhance`, in any mode, over every mesh of a directory,
+// glob or manifest, with --jobs files at once, a progress bar with an ETA, resumable, and a
+// summary table (batch.h).
 #include "cli_common.h"
-#include "command_batch_core.h"
+
+#include "vertexflow/batch.h"
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <stdexcept>
@@ -18,9 +20,10 @@ namespace {
 struct BatchCliOptions {
   std::string input;
   std::string output_dir;
+  std::string manifest;
+  std::string reference_dir;
   BatchOptions batch;
-  bool no_projection = false;
-  bool keep_boundary_free = false;
+  GivenOptions given;
   bool no_metrics = false;
 };
 
@@ -36,12 +39,18 @@ void register_batch_command(CLI::App& app, const GlobalOptions& global) {
   auto o = std::make_shared<BatchCliOptions>();
   CLI::App* command = app.add_subcommand(
       "batch",
-      "Enhance every mesh of a directory or glob into OUT_DIR: failing files are reported and skipped, existing "
-      "outputs skipped unless --force, a summary table written (OUT_DIR/batch_summary.csv and .json)");
-  command->add_option("IN", o->input, "Directory (every file in it) or glob pattern (quoted) of input meshes")
-      ->required();
-  command->add_option("OUT_DIR", o->output_dir, "Output directory (created); each output has its input's file name")
-      ->required();
+      "Enhance every mesh of a directory, glob or manifest into OUT_DIR, in any mode of `enhance`: failing files are "
+      "reported and skipped, existing outputs skipped unless --force, a summary table written "
+      "(OUT_DIR/batch_summary.csv and .json)");
+  command->add_option("IN", o->input,
+                      "Directory (every mesh file in it) or glob pattern (quoted) of input meshes; or, with "
+                      "--manifest, leave it out");
+  command->add_option("OUT_DIR", o->output_dir, "Output directory (created); each output has its input's file name");
+  command->add_option("--manifest", o->manifest,
+                      "CSV (header input,reference,output) or JSON (list of {input, reference, output}) of the files; "
+                      "relative paths from the manifest's directory; a row with a reference runs reference mode");
+  command->add_option("--reference-dir", o->reference_dir,
+                      "Reference mode: each input's reference is the mesh of this directory with the input's stem");
   command->add_option("-j,--jobs", o->batch.jobs, "Files processed at once")
       ->check(CLI::Range(1, 1024))
       ->capture_default_str();
@@ -50,18 +59,28 @@ void register_batch_command(CLI::App& app, const GlobalOptions& global) {
                    "Threads per file (0: the cores divided among the jobs); results do not depend on it")
       ->check(CLI::Range(0, 1024))
       ->capture_default_str();
-  add_flow_options(command, o->batch.file.flow, o->no_projection);
-  command->add_flag("--free-boundary", o->keep_boundary_free, "Let boundary vertices move (default: fixed)");
-  command->add_flag("--strict", o->batch.file.flow.refuse_non_manifold,
-                    "Refuse (fail) non-manifold or inconsistently oriented meshes");
+  add_enhance_options(command, o->given);
   command->add_flag("--no-metrics", o->no_metrics,
                     "Leave the summary's rho, CV, flips and displacement empty (saves the measurement's time)");
   command->add_flag("--force", o->batch.file.force, "Enhance files whose output exists already (default: skip them)");
   command->callback([o, &global] {
-    o->batch.inputs = {o->input};
+    // Positional arguments fill from the left: with --manifest and one positional, it is OUT_DIR.
+    if (!o->manifest.empty() && o->output_dir.empty()) std::swap(o->input, o->output_dir);
+    if (o->output_dir.empty()) throw std::runtime_error("batch: OUT_DIR is required");
+    if (o->manifest.empty() == o->input.empty())
+      throw std::runtime_error(o->manifest.empty() ? "batch: give IN (a directory or glob) or --manifest FILE"
+                                                   : "batch: give IN or --manifest FILE, not both");
+    if (!o->manifest.empty())
+      o->batch.items = read_batch_manifest(o->manifest);
+    else
+      o->batch.inputs = {o->input};
+    o->batch.reference_dir = o->reference_dir;
     o->batch.output_dir = o->output_dir;
-    o->batch.file.flow.project_to_input = !o->no_projection;
-    o->batch.file.flow.fix_boundary = !o->keep_boundary_free;
+    o->batch.file.enhance = enhance_options_from(o->given);
+    const bool references =
+        !o->reference_dir.empty() || std::any_of(o->batch.items.begin(), o->batch.items.end(),
+                                                 [](const BatchItem& item) { return !item.reference.empty(); });
+    validate_enhance_options(o->batch.file.enhance, references, -1, OptionNaming::Cli);
     o->batch.file.metrics = !o->no_metrics;
     const bool tty = ::isatty(STDERR_FILENO) == 1;
     if (!global.quiet) {

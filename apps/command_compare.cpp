@@ -28,8 +28,8 @@ nlohmann::json mesh_json(const std::string& file, const Mesh& mesh) {
 }
 
 nlohmann::json symmetric_json(const SymmetricDistance& d, double scale, const char* a_to_b, const char* b_to_a) {
-  return {{a_to_b, to_json(d.a_to_b, scale)},
-          {b_to_a, to_json(d.b_to_a, scale)},
+  return {{a_to_b, distance_stats_json(d.a_to_b, scale)},
+          {b_to_a, distance_stats_json(d.b_to_a, scale)},
           {"hausdorff", d.hausdorff},
           {"hausdorff_relative", d.hausdorff / scale}};
 }
@@ -64,7 +64,7 @@ nlohmann::json comparison_json(const MeshComparison& c, const CompareCommandOpti
   j["redistribution_rho"] = {{"input", c.redistribution_rho_input}, {"result", c.redistribution_rho_result}};
   j["abs_mean_curvature"] = {{"input", percentiles_json(c.abs_mean_curvature_input)},
                              {"result", percentiles_json(c.abs_mean_curvature_result)}};
-  j["quality"] = {{"input", to_json(c.quality_input)}, {"result", to_json(c.quality_result)}};
+  j["quality"] = {{"input", nlohmann::json(c.quality_input)}, {"result", nlohmann::json(c.quality_result)}};
   j["degenerate_faces"] = {{"input", c.degenerate_faces_input}, {"result", c.degenerate_faces_result}};
   j["flipped_faces"] = c.flipped_faces ? nlohmann::json{{"applicable", true}, {"count", *c.flipped_faces}}
                                        : nlohmann::json{{"applicable", false}, {"reason", kNotApplicable}};

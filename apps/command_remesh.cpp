@@ -104,7 +104,7 @@ void register_remesh_command(CLI::App& app, const GlobalOptions& global) {
       out["iterations"] = o->remesh.isotropic.iterations;
       out["protect_boundary"] = o->remesh.isotropic.protect_boundary;
       out["seconds"] = r.seconds;
-      out["quality"] = to_json(quality);
+      out["quality"] = nlohmann::json(quality);
       out["repairs"] = to_json(r.repairs);
       fmt::print("{}\n", out.dump(2));
     }

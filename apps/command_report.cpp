@@ -1,11 +1,10 @@
-// `vertexflow report INPUT RESULT OUT.html [--json-report FILE]`: the HTML report of a flow
+// `vertexflow report INPUT RESULT OUT.html [--json-report FILE]`: the HTML report of an enhance
 // result that already exists (for example from an earlier `vertexflow enhance`).
 #include "cli_common.h"
-#include "report_support.h"
 
 #include "vertexflow/compare.h"
+#include "vertexflow/enhance.h"
 #include "vertexflow/html_report.h"
-#include "vertexflow/topology.h"
 
 #include <fmt/format.h>
 
@@ -28,8 +27,11 @@ void register_report_command(CLI::App& app, const GlobalOptions& global) {
   auto o = std::make_shared<ReportOptions>();
   CLI::App* command = app.add_subcommand(
       "report", "Write an HTML report (3D views, colour maps, quality histograms, metrics) of a result and its input");
-  command->add_option("INPUT", o->input, "The mesh given to the flow")->required();
-  command->add_option("RESULT", o->result, "The flow's result (the input's connectivity, moved vertices)")->required();
+  command->add_option("INPUT", o->input, "The mesh given to `vertexflow enhance`")->required();
+  command
+      ->add_option("RESULT", o->result,
+                   "Its result: the input's vertices moved, with the input's faces or, after --edge-flips, its own")
+      ->required();
   command->add_option("OUT", o->html_file, "The HTML file to write (self-contained, works offline)")->required();
   command->add_option("--json-report", o->json_file, "Also write the metrics as JSON to this file");
   command
@@ -42,20 +44,19 @@ void register_report_command(CLI::App& app, const GlobalOptions& global) {
     check_outputs({o->input, o->result}, {{o->html_file}, {o->json_file}}, /*force=*/false);
     const Mesh input = read_mesh_with_warnings(o->input, global);
     const Mesh result = read_mesh_with_warnings(o->result, global);
-    if (result.num_vertices() != input.num_vertices() || result.F != input.F)
+    // Edge flips give a result faces of its own, but never another vertex or face count.
+    if (result.num_vertices() != input.num_vertices() || result.num_faces() != input.num_faces())
       throw std::runtime_error(fmt::format(
-          "{}: not the connectivity of {} ({} vertices, {} faces here, {} vertices, {} faces there): a report compares "
-          "a flow result with its own input",
+          "{}: not a result of {} ({} vertices, {} faces here, {} vertices, {} faces there): a report compares an "
+          "enhance result with its own input",
           o->result, o->input, result.num_vertices(), result.num_faces(), input.num_vertices(), input.num_faces()));
-    // The topology of the shared faces and each mesh's curvature, computed once for the
-    // metrics and the HTML report.
+    // Each mesh's curvature, computed once for the metrics and the HTML report.
     nlohmann::json metrics;
-    ReportCurvatures curvatures;
-    Topology topology;
+    EnhanceCurvatures curvatures;
     try {
-      topology = checked_topology(result, MeshRole::Result);
-      curvatures = report_curvatures(input, result, topology);
-      metrics = flow_metrics(input, result, topology, curvatures);
+      metrics = enhance_metrics(input, result, nullptr, &curvatures);
+    } catch (const CompareError& e) {
+      throw std::runtime_error((e.role() == MeshRole::Result ? o->result : o->input) + ": " + e.what());
     } catch (const std::invalid_argument& e) {
       throw std::runtime_error(o->input + ": " + e.what());
     }

@@ -71,7 +71,7 @@ void register_simplify_command(CLI::App& app, const GlobalOptions& global) {
       out["reached_target"] = r.reached_target;
       out["keep_boundary"] = o->simplify.keep_boundary;
       out["seconds"] = r.seconds;
-      out["quality"] = to_json(quality);
+      out["quality"] = nlohmann::json(quality);
       out["repairs"] = to_json(r.repairs);
       fmt::print("{}\n", out.dump(2));
     }

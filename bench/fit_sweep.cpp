@@ -59,7 +59,7 @@ int main(int argc, char** argv) {
     else if (k == "tol")
       o.tolerance = v;
     else if (k == "minq")
-      o.min_quality = v;
+      o.guard.min_quality = v;
     else if (k == "smooth")
       smooth = static_cast<int>(v);
     else if (k == "flow")

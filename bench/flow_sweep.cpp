@@ -45,7 +45,7 @@ int main(int argc, char** argv) {
     else if (k == "fa")
       o.feature_angle = v;
     else if (k == "minq")
-      o.min_quality = v;
+      o.guard.min_quality = v;
     else if (k == "csmooth")
       o.curvature.smoothing_rounds = static_cast<int>(v);
     else if (k == "dpasses")

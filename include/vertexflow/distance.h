@@ -66,6 +66,11 @@ struct ClosestPoint {
   Eigen::Vector3d barycentric = Eigen::Vector3d::Zero();
 };
 
+/// Diagnostic (the tests' hook): how many DistanceQuery trees this process has built over meshes
+/// of exactly `num_faces` faces. A command that measures against a dense reference builds one
+/// tree of it (reference_surface.h).
+std::uint64_t distance_trees_built(Index num_faces);
+
 /// Closest-point queries against a fixed mesh B: an AABB tree built once (with CGAL's internal
 /// k-d tree for the first guess), then queried any number of times, from any number of threads.
 /// Holds its own copy of B's triangles.

@@ -26,7 +26,7 @@
 namespace vertexflow {
 
 struct EdgeFlipOptions {
-  /// The quality floor of new faces (radius ratio), as FlowOptions::min_quality.
+  /// The quality floor of new faces (radius ratio), as GuardOptions::min_quality (guard.h).
   double min_quality = 0.3;
   /// The relative decrease of the pair's E a flip must bring (it keeps rounding noise and
   /// near-planar pairs from flipping back and forth).

@@ -23,7 +23,7 @@
 //   vertices by 1e-3 of its size after one round) and drift round after round.
 // Each round fixes the foot points, solves the linear least-squares problem (three right-hand
 // sides, one factorisation), and repairs flipped or too-poor faces with the flow's guard
-// (flow.h: FlowOptions::min_quality, sliver_floor). Rounds repeat until the data part of E (the
+// (guard.h: GuardOptions). Rounds repeat until the data part of E (the
 // mean of the two directions' mean squared distances) falls by less than `tolerance` of its
 // value in a round, or after max_rounds.
 //
@@ -34,7 +34,9 @@
 // vertices keep their input coordinates bit for bit.
 #pragma once
 
+#include "vertexflow/guard.h"
 #include "vertexflow/mesh.h"
+#include "vertexflow/reference_surface.h"
 
 #include <cstdint>
 #include <vector>
@@ -60,11 +62,11 @@ struct FitOptions {
   /// energy (about 2.5% of the RMS) stops after 4-6 rounds.
   int max_rounds = 10;
   double tolerance = 0.05;
-  bool fix_boundary = true;
-  std::vector<Index> pinned;
-  /// The guard's quality floor (FlowOptions::min_quality and sliver_floor).
-  double min_quality = 0.3;
-  double sliver_floor = 0.5;
+  /// Boundary (unless constraints.fix_boundary is false) and pinned vertices keep their input
+  /// coordinates bit for bit.
+  VertexConstraints constraints;
+  /// The guard after each round (guard.h), as the flow's.
+  GuardOptions guard;
   std::uint64_t seed = 1;
 };
 
@@ -171,12 +173,20 @@ struct SmoothFitOptions {
 /// smooth_surface_estimate, and for max_poor_face_fraction outside [0, 1].
 FitResult fit_to_smooth_surface(const Vertices& V, const Faces& F, const SmoothFitOptions& options = {});
 
+/// Checks the options' ranges: samples_per_vertex > 0, weights >= 0 and finite (proximity > 0),
+/// max_rounds >= 1, tolerance >= 0, the guard's (validate_guard_options), and pinned indices in
+/// [0, num_vertices) (when num_vertices >= 0). Throws std::invalid_argument prefixed with `what`.
+void validate_fit_options(const FitOptions& options, Index num_vertices = -1, const char* what = "fit to reference");
+
 /// Moves the vertices of (V, F) to minimise the two-sided distance to the reference surface
 /// (VR, FR), as described above. Throws std::invalid_argument for an empty mesh or reference,
-/// a non-finite coordinate, options out of range (samples_per_vertex > 0, weights >= 0 and
-/// finite, max_rounds >= 1, tolerance >= 0, min_quality and sliver_floor in
-/// [0, 1], pinned indices in range).
+/// a non-finite coordinate, or options out of range (validate_fit_options).
 FitResult fit_to_reference(const Vertices& V, const Faces& F, const Vertices& VR, const Faces& FR,
+                           const FitOptions& options = {});
+
+/// The same against a reference built once by the caller (reference_surface.h), whose tree and
+/// samples the fit reuses: the result is the same, bit for bit.
+FitResult fit_to_reference(const Vertices& V, const Faces& F, const ReferenceSurface& reference,
                            const FitOptions& options = {});
 
 }  // namespace vertexflow

@@ -29,6 +29,7 @@
 
 #include "vertexflow/curvature.h"
 #include "vertexflow/flow_energy.h"
+#include "vertexflow/guard.h"
 #include "vertexflow/mesh.h"
 #include "vertexflow/topology.h"
 
@@ -83,7 +84,7 @@ enum class LinearSolver {
 /// the reference's at v's foot point. Each vertex keeps that density as it moves (it moves by
 /// a fraction of an edge, over which the estimate does not change much), then is projected onto
 /// the surface as the solve's result is and the pass is guarded as a solve
-/// (FlowOptions::min_quality). Free boundary vertices (fix_boundary false) are left where the
+/// (FlowOptions::guard). Free boundary vertices (fix_boundary false) are left where the
 /// solve put them: their centroids lie inside the surface. The passes need project_to_input
 /// (validate_flow_options): unprojected, centroids inside convex regions shrink the mesh.
 /// Repeated, the passes equalise area times density around the vertices (a centroidal Voronoi
@@ -136,38 +137,17 @@ struct FlowOptions {
   /// of bunny_uniform (now 18) and cost 2 points of its edge-error CV reduction (-9.6% ->
   /// -11.8%). 180 or more disables it.
   double feature_angle = 40.0;
-  /// Keep boundary vertices where they are (paper, section 6).
-  bool fix_boundary = true;
-  /// Vertices held in place (indices into V).
-  std::vector<Index> pinned;
+  /// Boundary (unless constraints.fix_boundary is false) and pinned vertices stay where they are.
+  VertexConstraints constraints;
   /// Refuse (std::invalid_argument) a mesh that is not manifold or not consistently oriented
   /// instead of flowing its manifold split with the non-manifold vertices held (the CLI's
   /// --strict).
   bool refuse_non_manifold = false;
-  /// Halvings of a vertex's displacement before it is set to zero by the guard.
-  int max_halvings = 30;
-  /// The guard repairs every flipped or degenerate face, and every face whose radius ratio 2r/R
-  /// (quality.h) ends below its floor:
-  ///
-  ///     floor(f) = min(min_quality, worst input quality of the faces around f's corners)
-  ///                and, if f starts below min_quality, at most sliver_floor * f's input quality.
-  ///
-  /// So a face that starts at or above min_quality ends at or above it unless a worse face
-  /// touches it; the worst face around a vertex never ends below min(min_quality, the worst
-  /// input face around it), except that slivers (faces starting below min_quality) may lose
-  /// up to the fraction 1 - sliver_floor of their quality. A face may thus get worse than it
-  /// started as long as the worst face it touches does not: the earlier rule (no face below
-  /// its own input quality) froze sliver-heavy meshes (a thin genus-121 plate with 63% of its
-  /// faces below 0.3: 89% of the vertices shortened, rho +0.00; now, with the solve's sliver
-  /// term of flow_energy.h, 17.5% shortened and rho +0.13). The solve keeps no quality floor
-  /// itself; without the floor, CAD creases produced 0.3% (fandisk) to 3% (spot) of faces
-  /// below 0.3. The faces below min_quality are also the slivers of F_sliver. 0 disables it (only flipped and
-  /// degenerate faces are repaired).
-  double min_quality = 0.3;
-  /// See min_quality: the fraction of its input quality below which a sliver (a face that
-  /// starts below min_quality) may not fall. 1 keeps every sliver at least as good as its
-  /// worst neighbour at the input; 0 lets slivers go down to any positive area.
-  double sliver_floor = 0.5;
+  /// The guard after every solve (guard.h): no face flips or degenerates, none ends below its
+  /// quality floor. On the flow: without the floor, CAD creases produced 0.3% (fandisk) to 3%
+  /// (spot) of faces below 0.3; the faces below guard.min_quality are also the slivers of
+  /// F_sliver (flow_energy.h).
+  GuardOptions guard;
   CurvatureOptions curvature;
   /// Solver of the linear system; the choice does not change the energy that is minimised.
   LinearSolver solver = LinearSolver::Automatic;
@@ -212,10 +192,10 @@ struct FlowResult {
 /// Checks every option against its allowed range: lambda > 0, mu >= 0, epsilon > 0, sliver >= 0
 /// (all finite), d_percentile in [0, 100], iterations >= 1, density.passes in [0, 1000],
 /// density.exponent >= 0, density.epsilon > 0, density.step in (0, 1] (all finite), no density
-/// passes without project_to_input, feature_angle >= 0, max_halvings >=
-/// 1, min_quality and sliver_floor in [0, 1], solver_tolerance in (0, 1), curvature.smoothing_rounds >= 0, and (when
-/// num_vertices >= 0) every pinned index in [0, num_vertices). Throws std::invalid_argument naming the first option out
-/// of range and its allowed range.
+/// passes without project_to_input, feature_angle >= 0, the guard's options
+/// (validate_guard_options), solver_tolerance in (0, 1), curvature.smoothing_rounds >= 0, and
+/// (when num_vertices >= 0) every pinned index in [0, num_vertices). Throws std::invalid_argument naming the first
+/// option out of range and its allowed range.
 void validate_flow_options(const FlowOptions& options, Index num_vertices = -1);
 
 /// Moves the vertices of (V, F) by vertex flow. Throws std::invalid_argument for options out

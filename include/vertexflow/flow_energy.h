@@ -21,7 +21,7 @@
 //   F_sliver = 1/|V| sum_{f sliver} sum_{corners i of f} ((v_i - p_i) . m_fi / h_fi)^2    (ours)
 //             m_fi = the unit vector in f's plane across the edge opposite i, towards i, and
 //             h_fi = the altitude of f at i (both at P); the slivers are the faces that start
-//             below FlowOptions::min_quality. It measures each sliver corner's move towards
+//             below FlowOptions::guard.min_quality. It measures each sliver corner's move towards
 //             its opposite edge in units of the distance at which the face flips.
 //
 // The system minimises F_tan + lambda F_sd + mu F_smo + sliver F_sliver

@@ -8,21 +8,25 @@
 // Self-contained: the viewer (three.js, bundled from npm with esbuild when vertexflow is built)
 // and the data are inside the file; it works offline from file:// and loads nothing. Mesh
 // data is base64 of little-endian typed arrays: float32 positions relative to the input's
-// bounding-box centre and uint32 triangle indices (stored once: the two meshes share them).
+// bounding-box centre and uint32 triangle indices (stored once when the two meshes share them;
+// a result with faces of its own, from edge flips, has its own indices too).
 // The bytes depend only on the arguments (no time stamps), so identical input gives an
 // identical file.
 //
 // Colours (computed here, not in the browser):
 // - Mean curvature H = (k1 + k2) / 2 (curvature.h) of each mesh, diverging map (colormap.h)
 //   red positive, blue negative; one range for both views, robust_color_limit of the input's H.
-// - Quality: per face, 2r/R = 0 red, 0.5 white, 1 blue (the diverging map of 0.5 - q).
+// - Quality: per face of each mesh's own faces, 2r/R = 0 red, 0.5 white, 1 blue (the diverging
+//   map of 0.5 - q).
 // - Displacement: |result - input| per vertex, white (0) to red (robust_color_limit of all).
 //
 // Large meshes: above `max_display_faces` faces the views show a vertex-clustering
-// decimation (one clustering of the input's vertices, applied to both meshes so they keep a
-// shared connectivity and the displacement map still matches), and the page says so. A merged
-// vertex shows the mean position and mean H / displacement of its vertices, a kept face the
-// mean quality of the faces merged into it. Histograms and metrics describe the full meshes.
+// decimation (one clustering of the input's vertices, applied to both meshes so they keep
+// shared vertices and the displacement map still matches; each mesh's faces are mapped
+// through it, those that collapse dropped, at most max_display_faces of each), and the page
+// says so. A merged vertex shows the mean position and mean H / displacement of its vertices,
+// a kept face the mean quality of the faces merged into it. Histograms and metrics describe
+// the full meshes.
 #pragma once
 
 #include "vertexflow/curvature.h"
@@ -46,21 +50,24 @@ struct HtmlReportOptions {
 
 /// The report page as one string (UTF-8 HTML).
 ///
-/// `result` must have the input's connectivity (same vertex count and the same faces), as
-/// vertex_flow returns. `metrics_json` is a JSON object shown as the metrics table (nested
+/// `result` must have the input's vertex and face counts: the input's faces, as vertex_flow
+/// returns, or faces of its own over the same vertices, as edge flips give (edge_flips.h); its
+/// view, quality colours, histogram and curvature then use its own faces, and displacement
+/// stays per vertex. `metrics_json` is a JSON object shown as the metrics table (nested
 /// objects become dotted names; {"input": a, "result": b} pairs and NAME_input / NAME_result
 /// keys become one row with two columns), e.g. the JSON of `vertexflow enhance --report`;
-/// an empty string gives an empty table. Throws std::invalid_argument when the connectivity
-/// differs, the mesh is not manifold (curvature.h), or metrics_json is not a JSON object.
+/// an empty string gives an empty table. Throws std::invalid_argument when the vertex or face
+/// counts differ, a result face has a corner that is not a vertex, a mesh is not manifold
+/// (curvature.h), or metrics_json is not a JSON object.
 std::string html_report(const Mesh& input, const Mesh& result, std::string_view metrics_json,
                         const HtmlReportOptions& options = {});
 
 /// The same with each mesh's curvature computed by the caller, who needs it too (`vertexflow
-/// enhance` measures both meshes with compare.h): principal_curvatures of the mesh with the
-/// default CurvatureOptions, as the overload above computes it; the page uses its mean
-/// curvature. The same bytes as the overload above. Throws as above (but for a non-manifold
-/// mesh, which has no curvature), and std::invalid_argument for a curvature without one entry
-/// per vertex.
+/// enhance` measures both meshes with compare.h): principal_curvatures of each mesh on its own
+/// faces with the default CurvatureOptions, as the overload above computes it; the page uses
+/// its mean curvature. The same bytes as the overload above. Throws as above (but for a
+/// non-manifold mesh, which has no curvature), and std::invalid_argument for a curvature
+/// without one entry per vertex.
 std::string html_report(const Mesh& input, const Mesh& result, const Curvature& input_curvature,
                         const Curvature& result_curvature, std::string_view metrics_json,
                         const HtmlReportOptions& options = {});

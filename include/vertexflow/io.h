@@ -67,6 +67,9 @@ std::string lowercase_extension(const std::filesystem::path& path);
 /// Throws IoError for an unknown extension.
 MeshFormat format_from_path(const std::filesystem::path& path);
 
+/// Whether the path has a mesh extension format_from_path accepts.
+bool is_mesh_path(const std::filesystem::path& path);
+
 /// Whether the path ends in ".gz" (case-insensitive).
 bool is_gzip_path(const std::filesystem::path& path);
 

@@ -13,12 +13,14 @@
 #pragma once
 
 #include "vertexflow/curvature.h"
+#include "vertexflow/distance.h"
 #include "vertexflow/fit.h"
 #include "vertexflow/flow.h"
 #include "vertexflow/flow_energy.h"
+#include "vertexflow/quality.h"
 #include "vertexflow/unsharp.h"
 
-#include <nlohmann/json_fwd.hpp>
+#include <nlohmann/json.hpp>
 
 namespace vertexflow {
 
@@ -70,5 +72,12 @@ void to_json(nlohmann::json& j, const SmoothSurfaceOptions& options);
 /// and one per round, in the meshes' units; rounds; converged; reference_samples), "guard" (the
 /// guard's counts, as the flow's) and "seconds" (per phase).
 void to_json(nlohmann::json& j, const FitReport& report);
+
+/// {min, mean, p5, fraction_below_0_3, histogram} of the radius ratios (quality.h).
+void to_json(nlohmann::json& j, const QualityStats& stats);
+
+/// {mean, rms, max} in the meshes' units, the same divided by `length_scale` (*_relative), and
+/// the number of points measured (distance.h).
+nlohmann::json distance_stats_json(const DistanceStats& stats, double length_scale);
 
 }  // namespace vertexflow

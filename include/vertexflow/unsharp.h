@@ -25,6 +25,7 @@
 //   refusal.
 #pragma once
 
+#include "vertexflow/guard.h"
 #include "vertexflow/manifold_split.h"
 #include "vertexflow/mesh.h"
 
@@ -37,10 +38,8 @@ struct UnsharpOptions {
   double weight = 0.3;
   /// k: rounds of uniform Laplacian smoothing that define the detail. MeshLab's default, 5.
   int smoothing_iterations = 5;
-  /// Keep boundary vertices where they are.
-  bool fix_boundary = true;
-  /// Vertices held in place (indices into V).
-  std::vector<Index> pinned;
+  /// Boundary (unless constraints.fix_boundary is false) and pinned vertices stay where they are.
+  VertexConstraints constraints;
   /// Refuse (std::invalid_argument) a non-manifold mesh instead of smoothing its manifold
   /// split (the CLI's --strict).
   bool refuse_non_manifold = false;

@@ -1,9 +1,8 @@
 // The fit's linear system and rounds (fit_rounds.h).
 #include "fit_rounds.h"
 
-#include "../flow/guard.h"
+#include "../guard/guard.h"
 #include "numerics/sparse_cholesky.h"
-#include "vertexflow/features.h"
 #include "vertexflow/timing.h"
 
 #include <Eigen/SparseCore>
@@ -42,11 +41,15 @@ SparseMatrix uniform_laplacian(const Topology& topology, Index n) {
 }  // namespace
 
 void validate_fit(const Vertices& V, const Faces& F, const FitOptions& o, const std::string& context) {
-  auto require = [&context](bool ok, const std::string& what) {
-    if (!ok) throw std::invalid_argument(context + ": " + what);
+  if (V.rows() == 0 || F.rows() == 0) throw std::invalid_argument(context + ": the mesh is empty");
+  if (!V.allFinite()) throw std::invalid_argument(context + ": a coordinate is not finite");
+  validate_fit_options(o, V.rows(), context.c_str());
+}
+
+void validate_fit_options(const FitOptions& o, Index num_vertices, const char* what) {
+  auto require = [what](bool ok, const std::string& problem) {
+    if (!ok) throw std::invalid_argument(std::string(what) + ": " + problem);
   };
-  require(V.rows() > 0 && F.rows() > 0, "the mesh is empty");
-  require(V.allFinite(), "a coordinate is not finite");
   require(std::isfinite(o.samples_per_vertex) && o.samples_per_vertex > 0, "samples_per_vertex must be > 0");
   require(std::isfinite(o.mesh_to_reference_weight) && o.mesh_to_reference_weight >= 0,
           "mesh_to_reference_weight must be a finite number >= 0");
@@ -54,10 +57,8 @@ void validate_fit(const Vertices& V, const Faces& F, const FitOptions& o, const 
   require(std::isfinite(o.proximity) && o.proximity > 0, "proximity must be a finite number > 0");
   require(o.max_rounds >= 1, "max_rounds must be at least 1");
   require(std::isfinite(o.tolerance) && o.tolerance >= 0, "tolerance must be a finite number >= 0");
-  require(o.min_quality >= 0 && o.min_quality <= 1, "min_quality must be in [0, 1]");
-  require(o.sliver_floor >= 0 && o.sliver_floor <= 1, "sliver_floor must be in [0, 1]");
-  for (const Index p : o.pinned)
-    require(p >= 0 && p < V.rows(), "pinned vertex " + std::to_string(p) + " is out of range");
+  validate_guard_options(o.guard, what);
+  validate_vertex_constraints(o.constraints, num_vertices, what);
 }
 
 // The n x n system of one round, with three right-hand sides (x, y, z), on a pattern fixed
@@ -217,16 +218,15 @@ FitRounds::FitRounds(const Vertices& V, const Faces& F, Topology topology, const
   for (Index i = 0; i < n; ++i) {
     const auto v = static_cast<std::size_t>(i);
     // Vertices without faces have no data and no ring: nothing decides where they go.
-    fixed_[v] = (options.fix_boundary && topology_.is_boundary_vertex[v]) ||
+    fixed_[v] = (options.constraints.fix_boundary && topology_.is_boundary_vertex[v]) ||
                 topology_.face_offsets[v] == topology_.face_offsets[v + 1];
   }
-  for (const Index p : options.pinned) fixed_[static_cast<std::size_t>(p)] = 1;
+  for (const Index p : options.constraints.pinned) fixed_[static_cast<std::size_t>(p)] = 1;
   // Without fairness the pattern is the faces' alone, whose factor fills in far less than with
   // the anchored Laplacian's two-rings.
   const SparseMatrix L = options.fairness > 0 ? uniform_laplacian(topology_, n) : SparseMatrix(n, n);
   system_ = std::make_unique<FitSystem>(F, SparseMatrix(SparseMatrix(L.transpose()) * L), fixed_);
-  criteria_ = std::make_unique<GuardCriteria>(guard_criteria(V, F, options.min_quality, options.sliver_floor));
-  no_features_ = detect_features(V, F, topology_, 180.0);
+  criteria_ = std::make_unique<GuardCriteria>(guard_criteria(V, F, options.guard));
   shortened_.assign(static_cast<std::size_t>(n), 0);
 }
 
@@ -238,16 +238,17 @@ Vertices FitRounds::step(const Vertices& X, const std::vector<DataRow>& to_mesh,
   Vertices Y = system_->solve(X, to_mesh, to_reference, options_);
   report.seconds_solve += seconds_since(start);
   start = Clock::now();
-  FlowOptions guard_options;
-  guard_options.project_to_input = false;  // the fit leaves the input on purpose
-  guard(Y, X, V_, *criteria_, fixed_, topology_, no_features_, guard_options, shortened_, guard_report_);
+  // No reprojection: the fit leaves the input on purpose.
+  const GuardCounts counts = guard(Y, X, *criteria_, fixed_, topology_, options_.guard, {}, shortened_);
+  guard_counts_.flipped_before_guard += counts.flipped_before_guard;
+  guard_counts_.low_quality_before_guard += counts.low_quality_before_guard;
   report.seconds_guard += seconds_since(start);
   return Y;
 }
 
 Vertices FitRounds::finish(Vertices X, FitReport& report) const {
-  report.flipped_before_guard = guard_report_.flipped_before_guard;
-  report.low_quality_before_guard = guard_report_.low_quality_before_guard;
+  report.flipped_before_guard = guard_counts_.flipped_before_guard;
+  report.low_quality_before_guard = guard_counts_.low_quality_before_guard;
   report.limited_vertices = static_cast<Index>(std::count(shortened_.begin(), shortened_.end(), 1));
   for (Index i = 0; i < X.rows(); ++i) {
     if (fixed_[static_cast<std::size_t>(i)]) X.row(i) = V_.row(i);

@@ -1,11 +1,10 @@
 // Internal to the fit stage: the linear system and the rounds that reference mode and smooth
-// mode share (fit.h): data rows, the energy's solve on a fixed pattern, and the flow's guard
+// mode share (fit.h): data rows, the energy's solve on a fixed pattern, and the guard (guard.h)
 // after every solve.
 #pragma once
 
-#include "vertexflow/features.h"
 #include "vertexflow/fit.h"
-#include "vertexflow/flow.h"
+#include "vertexflow/guard.h"
 #include "vertexflow/topology.h"
 
 #include <cstdint>
@@ -34,7 +33,7 @@ void validate_fit(const Vertices& V, const Faces& F, const FitOptions& options, 
 class FitSystem;
 
 /// The state of a fit's rounds: which vertices are fixed (boundary unless
-/// options.fix_boundary is false, pins, vertices without faces), the system, and the guard.
+/// options.constraints.fix_boundary is false, pins, vertices without faces), the system, and the guard.
 class FitRounds {
  public:
   FitRounds(const Vertices& V, const Faces& F, const FitOptions& options);
@@ -61,9 +60,8 @@ class FitRounds {
   std::vector<char> fixed_;
   std::unique_ptr<FitSystem> system_;
   std::unique_ptr<GuardCriteria> criteria_;
-  SurfaceFeatures no_features_;  // the guard projects nothing: no creases to keep
   std::vector<char> shortened_;
-  FlowReport guard_report_;
+  GuardCounts guard_counts_;
 };
 
 }  // namespace vertexflow

@@ -63,17 +63,22 @@ FitResult fit_to_reference(const Vertices& V, const Faces& F, const Vertices& VR
   validate_fit(V, F, options, "fit to reference");
   if (VR.rows() == 0 || FR.rows() == 0) throw std::invalid_argument("fit to reference: the reference is empty");
   if (!VR.allFinite()) throw std::invalid_argument("fit to reference: a coordinate is not finite");
+  return fit_to_reference(V, F, ReferenceSurface(VR, FR), options);
+}
+
+FitResult fit_to_reference(const Vertices& V, const Faces& F, const ReferenceSurface& reference,
+                           const FitOptions& options) {
+  validate_fit(V, F, options, "fit to reference");
   FitResult result;
   FitReport& report = result.report;
   const Index n = V.rows();
-  // The reference's tree (CGAL builds it on one thread per half, distance.cpp) alongside its
-  // samples and the system's ordering and analysis.
+  // The reference's tree (built once per ReferenceSurface; CGAL builds it on one thread per
+  // half, distance.cpp) alongside its samples and the system's ordering and analysis.
   auto start = Clock::now();
-  std::optional<DistanceQuery> reference;
   std::optional<FitRounds> rounds;
-  Vertices samples;
+  const Vertices* samples_pointer = nullptr;
   std::vector<DataRow> to_mesh, to_reference;
-  tbb::parallel_invoke([&] { reference.emplace(VR, FR); },
+  tbb::parallel_invoke([&] { (void)reference.distance_query(); },
                        [&] {
                          SamplingOptions sampling;
                          sampling.samples =
@@ -81,9 +86,11 @@ FitResult fit_to_reference(const Vertices& V, const Faces& F, const Vertices& VR
                          sampling.seed = options.seed;
                          sampling.vertices = false;
                          sampling.edge_midpoints = false;
-                         samples = sample_surface(VR, FR, sampling).points;
+                         samples_pointer = &reference.samples(sampling).points;
                          rounds.emplace(V, F, options);
                        });
+  const Vertices& samples = *samples_pointer;
+  const DistanceQuery& tree = reference.distance_query();
   report.reference_samples = samples.rows();
   report.seconds_tree += seconds_since(start);
 
@@ -92,7 +99,7 @@ FitResult fit_to_reference(const Vertices& V, const Faces& F, const Vertices& VR
   for (int round = 0;; ++round) {
     start = Clock::now();
     const double to_mesh_ms = rows_to_mesh(X, F, samples, to_mesh);
-    const double to_reference_ms = rows_to_reference(X, F, *reference, to_reference);
+    const double to_reference_ms = rows_to_reference(X, F, tree, to_reference);
     report.seconds_queries += seconds_since(start);
     const double energy = 0.5 * (to_mesh_ms + to_reference_ms);
     report.rms_distance.push_back(std::sqrt(energy));

@@ -3,10 +3,10 @@
 // guard against flipped, degenerate and worsened faces (guard.h).
 #include "vertexflow/flow.h"
 
+#include "../guard/guard.h"
 #include "density_relaxation.h"
 #include "flow_setup.h"
 #include "flow_solver.h"
-#include "guard.h"
 #include "surface_projection.h"
 #include "vertexflow/curvature.h"
 #include "vertexflow/distance.h"
@@ -34,9 +34,7 @@ void validate_flow_options(const FlowOptions& o, Index num_vertices) {
   require(o.d_percentile >= 0 && o.d_percentile <= 100, "d_percentile must be in [0, 100]");
   require(o.iterations >= 1, "iterations must be at least 1");
   require(o.feature_angle >= 0, "feature_angle must be >= 0 degrees (180 or more disables creases)");
-  require(o.max_halvings >= 1, "max_halvings must be at least 1");
-  require(o.min_quality >= 0 && o.min_quality <= 1, "min_quality must be in [0, 1]");
-  require(o.sliver_floor >= 0 && o.sliver_floor <= 1, "sliver_floor must be in [0, 1]");
+  validate_guard_options(o.guard, "vertex flow");
   require(o.solver_tolerance > 0 && o.solver_tolerance < 1, "solver_tolerance must be in (0, 1)");
   require(o.curvature.smoothing_rounds >= 0, "curvature.smoothing_rounds must be >= 0");
   require(o.density.passes >= 0 && o.density.passes <= 1000, "density.passes must be in [0, 1000]");
@@ -46,11 +44,7 @@ void validate_flow_options(const FlowOptions& o, Index num_vertices) {
   require(std::isfinite(o.density.step) && o.density.step > 0 && o.density.step <= 1, "density.step must be in (0, 1]");
   require(o.density.passes == 0 || o.project_to_input,
           "density passes need the projection (project_to_input): unprojected, the centroids shrink the mesh");
-  if (num_vertices < 0) return;
-  for (const Index p : o.pinned)
-    if (p < 0 || p >= num_vertices)
-      throw std::invalid_argument("vertex flow: pinned vertex " + std::to_string(p) + " is out of range [0, " +
-                                  std::to_string(num_vertices) + ")");
+  validate_vertex_constraints(o.constraints, num_vertices, "vertex flow");
 }
 
 namespace {
@@ -66,13 +60,13 @@ FlowResult flow_on_manifold_split(const Vertices& V, const Faces& F, const Topol
   const ManifoldSplit split = split_non_manifold(V, F, topology);
   FlowOptions on_split = options;
   on_split.refuse_non_manifold = true;  // the split is manifold and oriented (manifold_split.h)
-  on_split.pinned.clear();
+  on_split.constraints.pinned.clear();
   auto pin_copies = [&](Index v) {
     for (Index s = split.first_copy[static_cast<std::size_t>(v)]; s < split.first_copy[static_cast<std::size_t>(v) + 1];
          ++s)
-      on_split.pinned.push_back(s);
+      on_split.constraints.pinned.push_back(s);
   };
-  for (const Index v : options.pinned) pin_copies(v);
+  for (const Index v : options.constraints.pinned) pin_copies(v);
   for (Index v = 0; v < static_cast<Index>(V.rows()); ++v)
     if (split.held[static_cast<std::size_t>(v)]) pin_copies(v);
   FlowResult on_copies = check_then(split.V, split.F, build_topology(split.F, split.V.rows()), on_split, reference);
@@ -106,8 +100,6 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
         DistanceQuery(VS, reference->F),
         principal_curvatures(VS, reference->F, build_topology(reference->F, VS.rows()), options.curvature)});
   }
-  FlowOptions guard_options = options;
-  if (surface) guard_options.project_to_input = false;  // shortened vertices are not projected onto S
   const std::vector<char>& fixed = setup.fixed;
   const Vertices& input = setup.input;
   report.fixed_vertices = static_cast<Index>(std::count(fixed.begin(), fixed.end(), 1));
@@ -116,7 +108,7 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
   Vertices X = input;
   // One solver for all rounds: the connectivity is fixed, so its ordering is computed once.
   FlowSystemSolver solver(topology, fixed, options.solver, options.solver_tolerance);
-  const GuardCriteria criteria = guard_criteria(input, F, options.min_quality, options.sliver_floor);
+  const GuardCriteria criteria = guard_criteria(input, F, options.guard);
   std::vector<char> shortened(static_cast<std::size_t>(n), 0);
   std::vector<Index> free_rows;
   for (Index i = 0; i < n; ++i) {
@@ -131,6 +123,13 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
       project_near_vertices(Y, rows, input, F, topology, setup.features);
     }
   };
+  // The guard puts the vertices it shortens back onto the input (those of the flow on S are not
+  // projected onto S).
+  Reprojection reproject;
+  if (options.project_to_input && !surface)
+    reproject = [&](Vertices& Y, const std::vector<Index>& rows) {
+      project_near_vertices(Y, rows, input, F, topology, setup.features);
+    };
   // The surface's curvature at the input positions, for the density passes.
   Curvature surface_curvature;
   for (int round = 0; round < options.iterations; ++round) {
@@ -154,7 +153,9 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
     // X, and on the unguarded fandisk after three rounds (671 flipped or degenerate faces) it
     // reached 1e15 per mean edge length, which made the normal matrix numerically indefinite.
     start = Clock::now();
-    guard(X, start_of_round, input, criteria, fixed, topology, setup.features, guard_options, shortened, report);
+    const GuardCounts counts = guard(X, start_of_round, criteria, fixed, topology, options.guard, reproject, shortened);
+    report.flipped_before_guard += counts.flipped_before_guard;
+    report.low_quality_before_guard += counts.low_quality_before_guard;
     report.seconds_guard += seconds_since(start);
   }
 
@@ -165,7 +166,6 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
     const auto start = Clock::now();
     const Eigen::VectorXd density = sizing_density(surface_curvature, options.density);
     std::vector<char> density_shortened(static_cast<std::size_t>(n), 0);
-    FlowReport pass_report;
     // Free boundary vertices (fix_boundary false) stay where the solve put them: their centroid
     // lies inside the surface, and nothing would hold them on the boundary line.
     std::vector<Index> interior_rows;
@@ -175,8 +175,7 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
       const Vertices start_of_pass = X;
       X = density_pass_proposal(X, F, topology, density, interior_rows, options.density.step);
       project(X, interior_rows);  // only the moved rows: the Phong lift is not idempotent
-      guard(X, start_of_pass, input, criteria, fixed, topology, setup.features, guard_options, density_shortened,
-            pass_report);
+      guard(X, start_of_pass, criteria, fixed, topology, options.guard, reproject, density_shortened);
     }
     report.density_limited_vertices =
         static_cast<Index>(std::count(density_shortened.begin(), density_shortened.end(), 1));

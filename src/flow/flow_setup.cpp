@@ -53,10 +53,11 @@ FlowSetup prepare_flow(const Vertices& V, const Faces& F, const Topology& topolo
   std::vector<char>& fixed = setup.fixed;
   fixed.assign(static_cast<std::size_t>(n), 0);
   for (Index i = 0; i < n; ++i) {
-    if ((options.fix_boundary && topology.is_boundary_vertex[static_cast<std::size_t>(i)]) || topology.valence(i) == 0)
+    if ((options.constraints.fix_boundary && topology.is_boundary_vertex[static_cast<std::size_t>(i)]) ||
+        topology.valence(i) == 0)
       fixed[static_cast<std::size_t>(i)] = 1;
   }
-  for (const Index p : options.pinned) fixed[static_cast<std::size_t>(p)] = 1;
+  for (const Index p : options.constraints.pinned) fixed[static_cast<std::size_t>(p)] = 1;
   setup.features = detect_features(V, F, topology, options.project_to_input ? options.feature_angle : 180.0);
   for (Index i = 0; i < n; ++i) {
     if (setup.features.vertex_kind[static_cast<std::size_t>(i)] == SurfaceFeatures::Kind::Corner)
@@ -67,10 +68,10 @@ FlowSetup prepare_flow(const Vertices& V, const Faces& F, const Topology& topolo
   setup.mean_edge_length = mean_edge_length(V, topology);
   setup.scale = setup.mean_edge_length > 0 ? setup.mean_edge_length : 1.0;
   setup.input = (V.rowwise() - setup.centroid) / setup.scale;
-  if (options.min_quality > 0 && options.weights.sliver > 0) {
+  if (options.guard.min_quality > 0 && options.weights.sliver > 0) {
     const Eigen::VectorXd quality = triangle_quality(setup.input, F);
     for (Index f = 0; f < static_cast<Index>(F.rows()); ++f)
-      if (quality[f] < options.min_quality) setup.sliver_faces.push_back(f);
+      if (quality[f] < options.guard.min_quality) setup.sliver_faces.push_back(f);
   }
   return setup;
 }

@@ -15,7 +15,7 @@
 namespace vertexflow {
 
 struct FlowSetup {
-  /// Held at the input: boundary vertices (when options.fix_boundary), isolated vertices (no
+  /// Held at the input: boundary vertices (when options.constraints.fix_boundary), isolated vertices (no
   /// energy terms but the pull), pinned vertices and the corners of the features.
   std::vector<char> fixed;
   /// Sharp features for options.feature_angle, or none without the projection (which is what
@@ -27,7 +27,7 @@ struct FlowSetup {
   double scale = 1;
   double mean_edge_length = 0;
   Vertices input;
-  /// The faces whose input quality is below options.min_quality (flow_energy.h, F_sliver);
+  /// The faces whose input quality is below options.guard.min_quality (flow_energy.h, F_sliver);
   /// empty when min_quality or weights.sliver is 0.
   std::vector<Index> sliver_faces;
 };

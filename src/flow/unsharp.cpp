@@ -19,18 +19,18 @@ UnsharpResult unsharp_on_manifold_split(const Vertices& V, const Faces& F, const
   const ManifoldSplit split = split_non_manifold(V, F, topology);
   UnsharpOptions on_split = options;
   on_split.refuse_non_manifold = true;
-  on_split.pinned.clear();
+  on_split.constraints.pinned.clear();
   const auto n = static_cast<Index>(V.rows());
-  for (const Index p : options.pinned)
+  for (const Index p : options.constraints.pinned)
     if (p < 0 || p >= n)
       throw std::invalid_argument("unsharp mask: pinned vertex " + std::to_string(p) + " is out of range");
   std::vector<char> hold(static_cast<std::size_t>(n), 0);
-  for (const Index p : options.pinned) hold[static_cast<std::size_t>(p)] = 1;
+  for (const Index p : options.constraints.pinned) hold[static_cast<std::size_t>(p)] = 1;
   for (Index v = 0; v < n; ++v) {
     if (!hold[static_cast<std::size_t>(v)] && !split.held[static_cast<std::size_t>(v)]) continue;
     for (Index s = split.first_copy[static_cast<std::size_t>(v)]; s < split.first_copy[static_cast<std::size_t>(v) + 1];
          ++s)
-      on_split.pinned.push_back(s);
+      on_split.constraints.pinned.push_back(s);
   }
   const UnsharpResult on_copies = unsharp_mask(split.V, split.F, on_split);
   UnsharpResult result;
@@ -60,9 +60,10 @@ UnsharpResult unsharp_mask(const Vertices& V, const Faces& F, const UnsharpOptio
 
   std::vector<char> fixed(static_cast<std::size_t>(n), 0);
   for (Index i = 0; i < n; ++i)
-    if ((options.fix_boundary && topology.is_boundary_vertex[static_cast<std::size_t>(i)]) || topology.valence(i) == 0)
+    if ((options.constraints.fix_boundary && topology.is_boundary_vertex[static_cast<std::size_t>(i)]) ||
+        topology.valence(i) == 0)
       fixed[static_cast<std::size_t>(i)] = 1;
-  for (const Index p : options.pinned) {
+  for (const Index p : options.constraints.pinned) {
     if (p < 0 || p >= n)
       throw std::invalid_argument("unsharp mask: pinned vertex " + std::to_string(p) + " is out of range");
     fixed[static_cast<std::size_t>(p)] = 1;

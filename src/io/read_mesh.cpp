@@ -34,9 +34,9 @@ void fail(const std::string& name, const std::string& message) {
 
 void TextScanner::error(const std::string& message) const {
   const std::size_t end = std::min(pos_, text_.size());
-  const std::uint64_t line = 1 + (source_ ? source_->newlines_dropped() : 0) +
-                             static_cast<std::uint64_t>(
-                                 std::count(text_.begin(), text_.begin() + static_cast<std::ptrdiff_t>(end), '\n'));
+  const std::uint64_t line =
+      1 + (source_ ? source_->newlines_dropped() : 0) +
+      static_cast<std::uint64_t>(std::count(text_.begin(), text_.begin() + static_cast<std::ptrdiff_t>(end), '\n'));
   fail(name_, fmt::format("line {}: {}", line - std::min(lines_back_, line - 1), message));
 }
 
@@ -217,8 +217,7 @@ Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& repor
       // In 64 bits: the file's own numbering of vertex 2^31-1 does not fit an Index.
       if (v < 0 || v >= nv64)
         fail(name, fmt::format("face {} references vertex {}, but the file has {} vertices (valid: {}..{})", p,
-                               std::int64_t{v} + soup.index_base, nv64, soup.index_base,
-                               nv64 - 1 + soup.index_base));
+                               std::int64_t{v} + soup.index_base, nv64, soup.index_base, nv64 - 1 + soup.index_base));
     }
   }
   if (soup.weld_vertices) weld_identical_vertices(soup, report);
@@ -370,7 +369,14 @@ std::string lowercase_extension(const std::filesystem::path& path) {
   return ext;
 }
 
-bool is_gzip_path(const std::filesystem::path& path) { return lowercase_extension(path) == ".gz"; }
+bool is_gzip_path(const std::filesystem::path& path) {
+  return lowercase_extension(path) == ".gz";
+}
+
+bool is_mesh_path(const std::filesystem::path& path) {
+  const std::string ext = lowercase_extension(is_gzip_path(path) ? path.stem() : path);
+  return ext == ".obj" || ext == ".ply" || ext == ".off" || ext == ".stl";
+}
 
 MeshFormat format_from_path(const std::filesystem::path& path) {
   const std::string ext = lowercase_extension(is_gzip_path(path) ? path.stem() : path);
@@ -385,10 +391,14 @@ MeshFormat format_from_path(const std::filesystem::path& path) {
 
 const char* format_name(MeshFormat format) {
   switch (format) {
-    case MeshFormat::Obj: return "OBJ";
-    case MeshFormat::Ply: return "PLY";
-    case MeshFormat::Off: return "OFF";
-    case MeshFormat::Stl: return "STL";
+    case MeshFormat::Obj:
+      return "OBJ";
+    case MeshFormat::Ply:
+      return "PLY";
+    case MeshFormat::Off:
+      return "OFF";
+    case MeshFormat::Stl:
+      return "STL";
   }
   return "?";
 }
@@ -399,8 +409,8 @@ std::vector<std::string> ReadReport::warnings() const {
     if (count > 0) out.push_back(fmt::format("{} {}", count, what));
   };
   if (format_differs_from_extension)
-    out.push_back(fmt::format("the file's content is {}, not what its extension says; read as {}",
-                              format_name(format), format_name(format)));
+    out.push_back(fmt::format("the file's content is {}, not what its extension says; read as {}", format_name(format),
+                              format_name(format)));
   add(ply_extra_values_lines, "lines had more values than their element declares; the extra values were ignored");
   add(polygons_triangulated, "polygons triangulated");
   add(polygons_fanned, "polygons had no planar triangulation (self-intersecting or folded) and were fanned");
@@ -449,7 +459,8 @@ Mesh read_mesh_checked(std::string_view bytes, MeshFormat format, const std::str
     source.request(kHeadBytes, 0);
     const std::string_view head = source.data().substr(0, kHeadBytes);
     if (head.empty()) io_detail::fail(name, "the file is empty");
-    const std::optional<MeshFormat> content = format_from_content(head, source.complete() ? source.data() : std::string_view());
+    const std::optional<MeshFormat> content =
+        format_from_content(head, source.complete() ? source.data() : std::string_view());
     if (content && *content != format) {
       r.format = *content;
       r.format_differs_from_extension = true;

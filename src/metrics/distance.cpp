@@ -15,6 +15,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <mutex>
 #include <numeric>
 #include <random>
 #include <stdexcept>
@@ -296,8 +298,29 @@ struct DistanceQuery::Impl {
   }
 };
 
+namespace {
+
+// distance_trees_built: trees by face count.
+std::mutex trees_mutex;
+std::map<Index, std::uint64_t>& trees_by_size() {
+  static std::map<Index, std::uint64_t> trees;
+  return trees;
+}
+
+}  // namespace
+
+std::uint64_t distance_trees_built(Index num_faces) {
+  const std::lock_guard lock(trees_mutex);
+  const auto it = trees_by_size().find(num_faces);
+  return it == trees_by_size().end() ? 0 : it->second;
+}
+
 DistanceQuery::DistanceQuery(const Vertices& V, const Faces& F) : impl_(std::make_unique<Impl>()) {
   if (F.rows() == 0) throw std::invalid_argument("DistanceQuery: the mesh has no faces");
+  {
+    const std::lock_guard lock(trees_mutex);
+    ++trees_by_size()[static_cast<Index>(F.rows())];
+  }
   check_indices(V, F, "DistanceQuery");
   impl_->V = V;
   impl_->F = F;

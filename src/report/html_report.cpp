@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <cstring>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
 #include <unordered_map>
 #include <vector>
@@ -65,23 +66,38 @@ std::string base64(const Colors& colors) {
   return base64(colors.data(), static_cast<std::size_t>(colors.size()));
 }
 
-// Which display vertex and face each mesh vertex and face becomes.
-struct DisplayMesh {
-  std::vector<Index> vertex_of;  // #V
-  std::vector<Index> face_of;    // #F; -1 for a face that collapsed
-  Index num_vertices = 0;
+// Which display face each face of one mesh becomes.
+struct DisplayFaces {
+  std::vector<Index> face_of;          // #F; -1 for a face that collapsed
   std::vector<std::uint32_t> indices;  // 3 per display face
-  [[nodiscard]] Index num_faces() const { return static_cast<Index>(indices.size() / 3); }
+  [[nodiscard]] Index size() const { return static_cast<Index>(indices.size() / 3); }
 };
 
-DisplayMesh full_display(const Faces& F, Index num_vertices) {
+// Which display vertex each mesh vertex becomes (one map for both meshes, so displacement
+// stays per vertex), and the display faces of the input and, when it has its own (edge flips),
+// of the result.
+struct DisplayMesh {
+  std::vector<Index> vertex_of;  // #V
+  Index num_vertices = 0;
+  DisplayFaces faces;
+  std::optional<DisplayFaces> result_faces;
+};
+
+DisplayFaces all_faces(const Faces& F) {
+  DisplayFaces d;
+  d.face_of.resize(static_cast<std::size_t>(F.rows()));
+  std::iota(d.face_of.begin(), d.face_of.end(), 0);
+  d.indices.assign(F.data(), F.data() + F.size());
+  return d;
+}
+
+DisplayMesh full_display(const Faces& F, const Faces* result_F, Index num_vertices) {
   DisplayMesh d;
   d.vertex_of.resize(static_cast<std::size_t>(num_vertices));
   std::iota(d.vertex_of.begin(), d.vertex_of.end(), 0);
-  d.face_of.resize(static_cast<std::size_t>(F.rows()));
-  std::iota(d.face_of.begin(), d.face_of.end(), 0);
   d.num_vertices = num_vertices;
-  d.indices.assign(F.data(), F.data() + F.size());
+  d.faces = all_faces(F);
+  if (result_F) d.result_faces = all_faces(*result_F);
   return d;
 }
 
@@ -98,9 +114,10 @@ struct TripleHash {
 // cell become one, faces with two corners in one cell vanish and faces over the same three
 // cells are kept once. Written here rather than taken from CGAL because it is for display only
 // and must (a) run in linear time on millions of faces, (b) give one vertex map that applies to
-// the input and the result alike, so both keep a shared connectivity and per-vertex
-// displacement; CGAL's edge-collapse simplification is neither linear nor shareable between two
-// meshes. Cluster and face order follow the mesh's order, so the output is deterministic.
+// the input and the result alike, so both keep shared vertices and per-vertex displacement
+// (and a result with its own faces has them mapped through the same clusters); CGAL's
+// edge-collapse simplification is neither linear nor shareable between two meshes. Cluster and
+// face order follow the mesh's order, so the output is deterministic.
 
 // Cluster of every vertex for cells of side `cell`; returns the number of clusters.
 Index cluster_once(const Vertices& V, const Eigen::Vector3d& origin, double cell, std::vector<Index>& cluster_of) {
@@ -133,9 +150,32 @@ Index surviving_faces(const Faces& F, const std::vector<Index>& cluster_of) {
   return n;
 }
 
-// Grows the cell until at most max_faces faces survive. The first guess assumes about two
-// faces per cluster and one occupied cell per cell-sized patch of surface.
-DisplayMesh cluster_vertices(const Vertices& V, const Faces& F, Index max_faces) {
+// F's faces over the clusters: collapsed faces dropped, faces over the same three clusters kept
+// once.
+DisplayFaces clustered_faces(const Faces& F, const std::vector<Index>& vertex_of, Index max_faces) {
+  DisplayFaces d;
+  d.face_of.assign(static_cast<std::size_t>(F.rows()), -1);
+  std::unordered_map<std::array<Index, 3>, Index, TripleHash> face_of_triple;
+  face_of_triple.reserve(static_cast<std::size_t>(max_faces));
+  for (Index f = 0; f < F.rows(); ++f) {
+    const std::array<Index, 3> c{vertex_of[static_cast<std::size_t>(F(f, 0))],
+                                 vertex_of[static_cast<std::size_t>(F(f, 1))],
+                                 vertex_of[static_cast<std::size_t>(F(f, 2))]};
+    if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) continue;
+    std::array<Index, 3> sorted = c;
+    std::sort(sorted.begin(), sorted.end());
+    const auto [it, inserted] = face_of_triple.try_emplace(sorted, d.size());
+    if (inserted)
+      d.indices.insert(d.indices.end(), {static_cast<std::uint32_t>(c[0]), static_cast<std::uint32_t>(c[1]),
+                                         static_cast<std::uint32_t>(c[2])});
+    d.face_of[static_cast<std::size_t>(f)] = it->second;
+  }
+  return d;
+}
+
+// Grows the cell until at most max_faces faces of each mesh survive. The first guess assumes
+// about two faces per cluster and one occupied cell per cell-sized patch of surface.
+DisplayMesh cluster_vertices(const Vertices& V, const Faces& F, const Faces* result_F, Index max_faces) {
   const BoundingBox box = bounding_box(V);
   double area = 0;
   for (Index f = 0; f < F.rows(); ++f) area += face_area(V, F, f);
@@ -146,28 +186,15 @@ DisplayMesh cluster_vertices(const Vertices& V, const Faces& F, Index max_faces)
   DisplayMesh d;
   for (;;) {
     d.num_vertices = cluster_once(V, box.min, cell, d.vertex_of);
-    const Index faces = surviving_faces(F, d.vertex_of);
+    Index faces = surviving_faces(F, d.vertex_of);
+    if (result_F) faces = std::max(faces, surviving_faces(*result_F, d.vertex_of));
     if (faces <= max_faces) break;
     // Face count falls roughly with the square of the cell size; at least 10% larger per try,
     // so a cell beyond the diagonal (one cluster, no faces) is reached in a few dozen tries.
     cell *= std::max(1.1, 1.02 * std::sqrt(static_cast<double>(faces) / max_faces));
   }
-  d.face_of.assign(static_cast<std::size_t>(F.rows()), -1);
-  std::unordered_map<std::array<Index, 3>, Index, TripleHash> face_of_triple;
-  face_of_triple.reserve(static_cast<std::size_t>(max_faces));
-  for (Index f = 0; f < F.rows(); ++f) {
-    const std::array<Index, 3> c{d.vertex_of[static_cast<std::size_t>(F(f, 0))],
-                                 d.vertex_of[static_cast<std::size_t>(F(f, 1))],
-                                 d.vertex_of[static_cast<std::size_t>(F(f, 2))]};
-    if (c[0] == c[1] || c[1] == c[2] || c[0] == c[2]) continue;
-    std::array<Index, 3> sorted = c;
-    std::sort(sorted.begin(), sorted.end());
-    const auto [it, inserted] = face_of_triple.try_emplace(sorted, d.num_faces());
-    if (inserted)
-      d.indices.insert(d.indices.end(), {static_cast<std::uint32_t>(c[0]), static_cast<std::uint32_t>(c[1]),
-                                         static_cast<std::uint32_t>(c[2])});
-    d.face_of[static_cast<std::size_t>(f)] = it->second;
-  }
+  d.faces = clustered_faces(F, d.vertex_of, max_faces);
+  if (result_F) d.result_faces = clustered_faces(*result_F, d.vertex_of, max_faces);
   return d;
 }
 
@@ -273,10 +300,15 @@ std::string fill_template(std::string_view title, std::string_view data, std::st
 // The checks both html_report overloads make before anything else, and the metrics parsed.
 Json checked_metrics(const Mesh& input, const Mesh& result, std::string_view metrics_json,
                      const HtmlReportOptions& options) {
-  if (result.V.rows() != input.V.rows() || result.F.rows() != input.F.rows() || result.F != input.F)
+  if (result.V.rows() != input.V.rows() || result.F.rows() != input.F.rows())
     throw std::invalid_argument(
-        fmt::format("the result ({} vertices, {} faces) does not have the input's connectivity ({} vertices, {} faces)",
+        fmt::format("the result ({} vertices, {} faces) does not have the input's vertex and face counts ({} vertices, "
+                    "{} faces): a report compares a result with its own input",
                     result.num_vertices(), result.num_faces(), input.num_vertices(), input.num_faces()));
+  // The result's own faces (edge flips) index the shared vertices; the input's are its own.
+  if (result.F != input.F && result.F.size() > 0 &&
+      (result.F.minCoeff() < 0 || result.F.maxCoeff() >= result.num_vertices()))
+    throw std::invalid_argument("the result has a face corner that is not one of its vertices");
   if (options.max_display_faces < 1) throw std::invalid_argument("max_display_faces must be at least 1");
   Json metrics = Json::object();
   if (!metrics_json.empty()) {
@@ -290,24 +322,28 @@ Json checked_metrics(const Mesh& input, const Mesh& result, std::string_view met
 std::string report_page(const Mesh& input, const Mesh& result, const Eigen::VectorXd& H_input,
                         const Eigen::VectorXd& H_result, Json metrics, const HtmlReportOptions& options) {
   const Faces& F = input.F;
+  // A result with faces of its own (edge flips) is shown, coloured and measured on them.
+  const Faces* result_F = result.F != F ? &result.F : nullptr;
   const Eigen::VectorXd q_input = triangle_quality(input.V, F);
-  const Eigen::VectorXd q_result = triangle_quality(result.V, F);
+  const Eigen::VectorXd q_result = triangle_quality(result.V, result.F);
   const Eigen::VectorXd moved = (result.V - input.V).rowwise().norm();
   // Limits from the full meshes, so a decimated view keeps the scale of the real data.
   const double H_limit = robust_color_limit(H_input);
   const double moved_limit = robust_color_limit(moved);
 
   const bool decimate = input.num_faces() > options.max_display_faces;
-  const DisplayMesh d =
-      decimate ? cluster_vertices(input.V, F, options.max_display_faces) : full_display(F, input.num_vertices());
+  const DisplayMesh d = decimate ? cluster_vertices(input.V, F, result_F, options.max_display_faces)
+                                 : full_display(F, result_F, input.num_vertices());
+  const DisplayFaces& result_faces = d.result_faces ? *d.result_faces : d.faces;
   const BoundingBox box = bounding_box(input.V);
   // float32 relative to the box centre keeps ~7 significant digits of the shape itself even
   // for meshes far from the origin.
   const Eigen::Vector3d offset = 0.5 * (box.min + box.max);
 
-  const auto mesh_data = [&](const Vertices& V, const Eigen::VectorXd& H, const Eigen::VectorXd& q) {
+  const auto mesh_data = [&](const Vertices& V, const Eigen::VectorXd& H, const DisplayFaces& faces,
+                             const Eigen::VectorXd& q) {
     const Eigen::VectorXd H_shown = average(d.vertex_of, d.num_vertices, H);
-    const Eigen::VectorXd q_shown = average(d.face_of, d.num_faces(), q);
+    const Eigen::VectorXd q_shown = average(faces.face_of, faces.size(), q);
     return Json{{"positions", base64(float_positions(decimate ? average_rows(d, V) : V, offset))},
                 {"mean_curvature", base64(diverging_colors(H_shown, H_limit))},
                 {"quality", base64(diverging_colors(Eigen::VectorXd(0.5 - q_shown.array()), 0.5))}};
@@ -316,9 +352,11 @@ std::string report_page(const Mesh& input, const Mesh& result, const Eigen::Vect
   std::string note;
   if (decimate)
     note = fmt::format(
-        "Large mesh: the views show a decimation for display only ({} of {} faces, {} of {} vertices, by vertex "
+        "Large mesh: the views show a decimation for display only ({} of {} faces{}, {} of {} vertices, by vertex "
         "clustering). Histograms and metrics describe the full meshes.",
-        d.num_faces(), input.num_faces(), d.num_vertices, input.num_vertices());
+        d.faces.size(), input.num_faces(),
+        d.result_faces ? fmt::format(", {} of the result's own faces", d.result_faces->size()) : "", d.num_vertices,
+        input.num_vertices());
 
   Json data;
   data["format"] = 1;
@@ -327,12 +365,17 @@ std::string report_page(const Mesh& input, const Mesh& result, const Eigen::Vect
   data["counts"] = {{"vertices", input.num_vertices()}, {"faces", input.num_faces()}};
   data["offset"] = {offset.x(), offset.y(), offset.z()};
   data["display"] = {{"vertices", d.num_vertices},
-                     {"faces", d.num_faces()},
+                     {"faces", d.faces.size()},
                      {"decimated", decimate},
                      {"note", note},
-                     {"indices", base64(d.indices)}};
-  data["input"] = mesh_data(input.V, H_input, q_input);
-  data["result"] = mesh_data(result.V, H_result, q_result);
+                     {"indices", base64(d.faces.indices)}};
+  // Only when they differ, so a result with the input's faces gives the same page as before.
+  if (d.result_faces) {
+    data["display"]["result_faces"] = d.result_faces->size();
+    data["display"]["result_indices"] = base64(d.result_faces->indices);
+  }
+  data["input"] = mesh_data(input.V, H_input, d.faces, q_input);
+  data["result"] = mesh_data(result.V, H_result, result_faces, q_result);
   data["displacement"] = base64(diverging_colors(average(d.vertex_of, d.num_vertices, moved), moved_limit));
   data["legend"] = {
       {"mean_curvature", legend(Eigen::Vector3d(-H_limit, 0, H_limit), H_limit, fmt::format("{:.3g}", -H_limit),
@@ -354,7 +397,9 @@ std::string html_report(const Mesh& input, const Mesh& result, std::string_view 
   Json metrics = checked_metrics(input, result, metrics_json, options);
   const Topology topology = build_topology(input.F, input.num_vertices());
   const Eigen::VectorXd H_input = principal_curvatures(input.V, input.F, topology).mean();
-  const Eigen::VectorXd H_result = principal_curvatures(result.V, input.F, topology).mean();
+  // Each mesh's curvature on its own faces (a result of edge flips has its own).
+  const Eigen::VectorXd H_result = result.F == input.F ? principal_curvatures(result.V, input.F, topology).mean()
+                                                       : principal_curvatures(result.V, result.F).mean();
   return report_page(input, result, H_input, H_result, std::move(metrics), options);
 }
 

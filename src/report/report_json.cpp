@@ -59,12 +59,12 @@ void to_json(nlohmann::json& j, const FlowOptions& options) {
             {"iterations", options.iterations},
             {"project_to_input", options.project_to_input},
             {"feature_angle", options.feature_angle},
-            {"fix_boundary", options.fix_boundary},
-            {"pinned", options.pinned.size()},
+            {"fix_boundary", options.constraints.fix_boundary},
+            {"pinned", options.constraints.pinned.size()},
             {"refuse_non_manifold", options.refuse_non_manifold},
-            {"max_halvings", options.max_halvings},
-            {"min_quality", options.min_quality},
-            {"sliver_floor", options.sliver_floor},
+            {"max_halvings", options.guard.max_halvings},
+            {"min_quality", options.guard.min_quality},
+            {"sliver_floor", options.guard.sliver_floor},
             {"curvature", options.curvature},
             {"solver", options.solver},
             {"solver_tolerance", options.solver_tolerance},
@@ -105,8 +105,8 @@ void to_json(nlohmann::json& j, const FlowReport& report) {
 void to_json(nlohmann::json& j, const UnsharpOptions& options) {
   j = {{"weight", options.weight},
        {"smoothing_iterations", options.smoothing_iterations},
-       {"fix_boundary", options.fix_boundary},
-       {"pinned", options.pinned.size()},
+       {"fix_boundary", options.constraints.fix_boundary},
+       {"pinned", options.constraints.pinned.size()},
        {"refuse_non_manifold", options.refuse_non_manifold}};
 }
 
@@ -125,10 +125,10 @@ void to_json(nlohmann::json& j, const FitOptions& options) {
        {"proximity", options.proximity},
        {"max_rounds", options.max_rounds},
        {"tolerance", options.tolerance},
-       {"fix_boundary", options.fix_boundary},
-       {"pinned", options.pinned.size()},
-       {"min_quality", options.min_quality},
-       {"sliver_floor", options.sliver_floor},
+       {"fix_boundary", options.constraints.fix_boundary},
+       {"pinned", options.constraints.pinned.size()},
+       {"min_quality", options.guard.min_quality},
+       {"sliver_floor", options.guard.sliver_floor},
        {"seed", options.seed}};
 }
 
@@ -148,6 +148,24 @@ void to_json(nlohmann::json& j, const FitReport& report) {
          {"solve", report.seconds_solve},
          {"guard", report.seconds_guard},
          {"surface", report.seconds_surface}}}};
+}
+
+void to_json(nlohmann::json& j, const QualityStats& stats) {
+  j = {{"min", stats.min},
+       {"mean", stats.mean},
+       {"p5", stats.p5},
+       {"fraction_below_0_3", stats.fraction_below_0_3},
+       {"histogram", stats.histogram}};
+}
+
+nlohmann::json distance_stats_json(const DistanceStats& stats, double length_scale) {
+  return {{"mean", stats.mean},
+          {"rms", stats.rms},
+          {"max", stats.max},
+          {"mean_relative", stats.mean / length_scale},
+          {"rms_relative", stats.rms / length_scale},
+          {"max_relative", stats.max / length_scale},
+          {"points", stats.points}};
 }
 
 void to_json(nlohmann::json& j, const SmoothSurfaceOptions& options) {

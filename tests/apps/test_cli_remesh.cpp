@@ -180,10 +180,10 @@ TEST(CliEnhanceUnsharp, OptionsOfTheOtherMethodAreRefused) {
   const auto out = dir.file("out.ply");
   expect_one_line_error(
       run_cli("enhance " + quoted_data_path("spot.obj") + " " + shell_quote(out.string()) + " --weight 0.5"),
-      "--weight and --smoothing-iterations apply to --method unsharp only");
+      "--weight does not apply to the paper's flow");
   expect_one_line_error(run_cli("enhance " + quoted_data_path("spot.obj") + " " + shell_quote(out.string()) +
                                 " --method unsharp --lambda 2"),
-                        "--lambda applies to --method flow only");
+                        "--lambda does not apply to --method unsharp");
   expect_one_line_error(run_cli("--quiet enhance " + shell_quote(write_bowtie(dir).string()) + " " +
                                 shell_quote(out.string()) + " --method unsharp --strict"),
                         "bowtie.obj: unsharp mask: the mesh is not manifold");

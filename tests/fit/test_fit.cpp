@@ -34,8 +34,8 @@ TwoSided two_sided(const Vertices& V, const Faces& F, const Mesh& reference) {
 
 // The promises of fit.h on any input.
 void expect_promises_kept(const Mesh& mesh, const FitResult& result, const FitOptions& options) {
-  test::expect_guard_promises_kept(mesh, result.V, options.fix_boundary, options.pinned, options.min_quality,
-                                   options.sliver_floor);
+  test::expect_guard_promises_kept(mesh, result.V, options.constraints.fix_boundary, options.constraints.pinned,
+                                   options.guard.min_quality, options.guard.sliver_floor);
   // The stopping rule: the RMS falls every round, and the rounds stop once the data energy
   // (RMS squared) falls by less than the tolerance, or at max_rounds.
   const auto& rms = result.report.rms_distance;
@@ -102,13 +102,13 @@ TEST(FitToReference, BoundaryAndPinsStay) {
   const Mesh coarse = read_mesh(test::data_path("hemisphere.off"));
   const Mesh dense = test::icosphere(1.0, 6);  // hemisphere.off lies on the unit sphere
   FitOptions options;
-  options.pinned = {0, 7, 11};
+  options.constraints.pinned = {0, 7, 11};
   const FitResult result = fit_to_reference(coarse.V, coarse.F, dense.V, dense.F, options);
   expect_promises_kept(coarse, result, options);
   const Topology topology = build_topology(coarse.F, coarse.num_vertices());
   Index moved_inside = 0, moved_boundary = 0;
   FitOptions free_boundary = options;
-  free_boundary.fix_boundary = false;
+  free_boundary.constraints.fix_boundary = false;
   const FitResult free = fit_to_reference(coarse.V, coarse.F, dense.V, dense.F, free_boundary);
   expect_promises_kept(coarse, free, free_boundary);
   for (Index v = 0; v < coarse.num_vertices(); ++v) {
@@ -156,8 +156,8 @@ TEST(FitToReference, RefusesBadInputAndOptions) {
   for (auto set : std::vector<void (*)(FitOptions&)>{
            [](FitOptions& o) { o.samples_per_vertex = 0; }, [](FitOptions& o) { o.fairness = -1; },
            [](FitOptions& o) { o.mesh_to_reference_weight = -1; }, [](FitOptions& o) { o.max_rounds = 0; },
-           [](FitOptions& o) { o.tolerance = -1; }, [](FitOptions& o) { o.min_quality = 2; },
-           [](FitOptions& o) { o.pinned = {1000}; }}) {
+           [](FitOptions& o) { o.tolerance = -1; }, [](FitOptions& o) { o.guard.min_quality = 2; },
+           [](FitOptions& o) { o.constraints.pinned = {1000}; }}) {
     FitOptions o;
     set(o);
     EXPECT_THROW(fit_to_reference(sphere.V, sphere.F, sphere.V, sphere.F, o), std::invalid_argument);

@@ -152,7 +152,7 @@ TEST(DensityRelaxation, LeavesAFreeBoundaryWhereTheSolvePutIt) {
   const Mesh hemisphere = read_mesh(test::data_path("hemisphere.off"));
   const Topology topology = build_topology(hemisphere.F, hemisphere.num_vertices());
   FlowOptions free = with_passes(10);
-  free.fix_boundary = false;
+  free.constraints.fix_boundary = false;
   const FlowResult passes = vertex_flow(hemisphere.V, hemisphere.F, free);
   free.density.passes = 0;
   const FlowResult flow = vertex_flow(hemisphere.V, hemisphere.F, free);

@@ -11,7 +11,7 @@
 #include "vertexflow/manifold_split.h"
 #include "vertexflow/quality.h"
 
-#include "guard.h"
+#include "guard/guard.h"
 #include "surface_projection.h"
 
 #include <gtest/gtest.h>
@@ -67,8 +67,8 @@ std::ostream& operator<<(std::ostream& out, const FlowExpectation& e) {
 // FlowOptions::min_quality states (exactly: up to the rounding of mapping the normalised result
 // back).
 void expect_promises_kept(const Mesh& mesh, const FlowResult& result, const FlowOptions& options = {}) {
-  test::expect_guard_promises_kept(mesh, result.V, options.fix_boundary, options.pinned, options.min_quality,
-                                   options.sliver_floor);
+  test::expect_guard_promises_kept(mesh, result.V, options.constraints.fix_boundary, options.constraints.pinned,
+                                   options.guard.min_quality, options.guard.sliver_floor);
 }
 
 // The promises, then the effect one flow at `options` must have on `mesh` (expectation).
@@ -162,7 +162,7 @@ TEST_P(FlowQualityPromise, EveryFaceEndsAtOrAboveItsFloor) {
   for (const double min_quality : {0.3, 0.5}) {
     SCOPED_TRACE(min_quality);
     FlowOptions options;
-    options.min_quality = min_quality;
+    options.guard.min_quality = min_quality;
     const FlowResult result = vertex_flow(mesh.V, mesh.F, options);
     std::cout << "[measured] " << GetParam() << " min_quality " << min_quality << ": low quality before guard "
               << result.report.low_quality_before_guard << ", limited " << result.report.limited_vertices << "\n";
@@ -293,11 +293,11 @@ TEST(FlowHardCases, SliverPlateOfGenus121Moves) {
   // face around them at the input) moves less; min_quality 0 (flips only, and no slivers for
   // F_sliver) moves more.
   FlowOptions strict_slivers;
-  strict_slivers.sliver_floor = 1;
+  strict_slivers.guard.sliver_floor = 1;
   const FlowResult strict = vertex_flow(plate.V, plate.F, strict_slivers);
   expect_promises_kept(plate, strict, strict_slivers);
   FlowOptions flips_only;
-  flips_only.min_quality = 0;
+  flips_only.guard.min_quality = 0;
   const FlowResult loose = vertex_flow(plate.V, plate.F, flips_only);
   expect_promises_kept(plate, loose, flips_only);
   EXPECT_LT(mean_displacement(strict.V, plate.V), mean_displacement(result.V, plate.V));
@@ -308,7 +308,7 @@ TEST(FlowHardCases, SliverPlateOfGenus121Moves) {
 // with and without it.
 TEST(FlowHardCases, SliverTermIsZeroWithoutSlivers) {
   const Mesh mesh = read_mesh(test::data_path("bunny_uniform.off"));
-  ASSERT_EQ((triangle_quality(mesh.V, mesh.F).array() < FlowOptions{}.min_quality).count(), 0);
+  ASSERT_EQ((triangle_quality(mesh.V, mesh.F).array() < FlowOptions{}.guard.min_quality).count(), 0);
   FlowOptions without;
   without.weights.sliver = 0;
   EXPECT_EQ(vertex_flow(mesh.V, mesh.F).V, vertex_flow(mesh.V, mesh.F, without).V);
@@ -325,7 +325,7 @@ TEST(FlowHardCases, NoisyScanWithSlivers) {
   expect_flow_effect(scan, result, {"noisy scan", 0.066, 0.045, 0.00075, 0.01, 0.083});
 }
 
-// The guard itself (src/flow/guard.h), on a flat grid where the proposed move of one vertex
+// The guard itself (src/guard/guard.h), on a flat grid where the proposed move of one vertex
 // flips faces while every other vertex makes a small good move: the guard repairs the flipped
 // faces by shortening only the vertex that flipped them, and leaves every other proposed move
 // as it was.
@@ -335,7 +335,6 @@ TEST(FlowGuard, RepairsBadFacesAndKeepsEveryGoodMove) {
   flat.V.col(2).setZero();
   const Index n = flat.num_vertices();
   const Topology topology = build_topology(flat.F, n);
-  const SurfaceFeatures features = detect_features(flat.V, flat.F, topology, 40.0);
   std::vector<char> fixed(static_cast<std::size_t>(n), 0);
   for (Index v = 0; v < n; ++v)
     fixed[static_cast<std::size_t>(v)] = topology.is_boundary_vertex[static_cast<std::size_t>(v)];
@@ -357,16 +356,14 @@ TEST(FlowGuard, RepairsBadFacesAndKeepsEveryGoodMove) {
   for (const Index f : flipped)
     for (int k = 0; k < 3; ++k) on_bad_face[static_cast<std::size_t>(flat.F(f, k))] = 1;
 
-  FlowOptions options;
-  options.project_to_input = false;
+  GuardOptions options;
   options.min_quality = 0;  // only flips and degenerate faces
-  const GuardCriteria criteria = guard_criteria(flat.V, flat.F, options.min_quality, options.sliver_floor);
+  const GuardCriteria criteria = guard_criteria(flat.V, flat.F, options);
   Vertices X = proposed;
   std::vector<char> shortened(static_cast<std::size_t>(n), 0);
-  FlowReport report;
-  guard(X, flat.V, flat.V, criteria, fixed, topology, features, options, shortened, report);
+  const GuardCounts counts = guard(X, flat.V, criteria, fixed, topology, options, {}, shortened);
   EXPECT_TRUE(flipped_faces(flat.V, X, flat.F).empty());
-  EXPECT_EQ(report.flipped_before_guard, static_cast<Index>(flipped.size()));
+  EXPECT_EQ(counts.flipped_before_guard, static_cast<Index>(flipped.size()));
   Index kept = 0;
   for (Index v = 0; v < n; ++v) {
     const auto i = static_cast<std::size_t>(v);
@@ -705,15 +702,15 @@ TEST(Flow, PinnedVerticesStay) {
   for (int k = 0; k < 5; ++k) {
     Index worst = 0;
     moved.maxCoeff(&worst);
-    options.pinned.push_back(worst);
+    options.constraints.pinned.push_back(worst);
     moved[worst] = -1;
   }
   const FlowResult pinned = vertex_flow(mesh.V, mesh.F, options);
-  for (const Index v : options.pinned) EXPECT_EQ(pinned.V.row(v), mesh.V.row(v)) << v;
+  for (const Index v : options.constraints.pinned) EXPECT_EQ(pinned.V.row(v), mesh.V.row(v)) << v;
   expect_moved(mesh, pinned.V, 0.056);  // the rest still flows (measured 0.14 unpinned)
   EXPECT_EQ(pinned.report.fixed_vertices, free_result.report.fixed_vertices + 5);
   FlowOptions out_of_range;
-  out_of_range.pinned = {mesh.num_vertices()};
+  out_of_range.constraints.pinned = {mesh.num_vertices()};
   EXPECT_THROW(vertex_flow(mesh.V, mesh.F, out_of_range), std::invalid_argument);
 }
 
@@ -766,7 +763,7 @@ TEST(Flow, DeterministicBetweenRuns) {
 TEST(Flow, FreeBoundaryMovesTheBoundaryOverTheInput) {
   const Mesh mesh = read_mesh(test::data_path("hemisphere.off"));
   FlowOptions options;
-  options.fix_boundary = false;
+  options.constraints.fix_boundary = false;
   const FlowResult result = vertex_flow(mesh.V, mesh.F, options);
   expect_promises_kept(mesh, result, options);
   const Topology topology = build_topology(mesh.F, mesh.num_vertices());
@@ -820,7 +817,7 @@ TEST(Flow, OneHalvingSendsEveryLimitedVertexHome) {
     return count;
   };
   FlowOptions options;
-  options.max_halvings = 1;
+  options.guard.max_halvings = 1;
   const FlowResult once = vertex_flow(scan.V, scan.F, options), halved = vertex_flow(scan.V, scan.F);
   expect_promises_kept(scan, once, options);
   std::cout << "[measured] max_halvings 1: " << once.report.limited_vertices << " limited, " << at_input(once.V)
@@ -863,15 +860,15 @@ TEST(Flow, ValidatesEveryOptionAndNamesIt) {
       {"d_percentile", [](FlowOptions& o) { o.d_percentile = 101; }},
       {"iterations", [](FlowOptions& o) { o.iterations = 0; }},
       {"feature_angle", [&](FlowOptions& o) { o.feature_angle = nan; }},
-      {"max_halvings", [](FlowOptions& o) { o.max_halvings = 0; }},
-      {"min_quality", [](FlowOptions& o) { o.min_quality = 1.5; }},
+      {"max_halvings", [](FlowOptions& o) { o.guard.max_halvings = 0; }},
+      {"min_quality", [](FlowOptions& o) { o.guard.min_quality = 1.5; }},
       {"solver_tolerance", [](FlowOptions& o) { o.solver_tolerance = 0; }},
       {"smoothing_rounds", [](FlowOptions& o) { o.curvature.smoothing_rounds = -1; }},
       {"pinned vertex 12",
        [](FlowOptions& o) {
-         o.pinned = {0, 12};
+         o.constraints.pinned = {0, 12};
        }},
-      {"pinned vertex -1", [](FlowOptions& o) { o.pinned = {-1}; }},
+      {"pinned vertex -1", [](FlowOptions& o) { o.constraints.pinned = {-1}; }},
   };
   for (const auto& [name, set] : cases) {
     FlowOptions options;

@@ -122,7 +122,7 @@ TEST(Unsharp, BoundaryAndPinnedVerticesStayExactly) {
   const Topology topology = build_topology(hemisphere.F, hemisphere.num_vertices());
   UnsharpOptions options;
   options.weight = 1.0;
-  options.pinned = {5, 100, 1000};
+  options.constraints.pinned = {5, 100, 1000};
   const UnsharpResult result = unsharp_mask(hemisphere.V, hemisphere.F, options);
   Index boundary = 0;
   for (Index v = 0; v < hemisphere.num_vertices(); ++v) {
@@ -131,15 +131,15 @@ TEST(Unsharp, BoundaryAndPinnedVerticesStayExactly) {
       EXPECT_EQ(result.V.row(v), hemisphere.V.row(v)) << v;
     }
   }
-  for (const Index p : options.pinned) {
+  for (const Index p : options.constraints.pinned) {
     ASSERT_FALSE(topology.is_boundary_vertex[static_cast<std::size_t>(p)]);
     EXPECT_EQ(result.V.row(p), hemisphere.V.row(p)) << p;
   }
   EXPECT_EQ(result.fixed_vertices, boundary + 3);
   EXPECT_GT((result.V - hemisphere.V).rowwise().norm().maxCoeff(), 0.0);
 
-  options.fix_boundary = false;
-  options.pinned.clear();
+  options.constraints.fix_boundary = false;
+  options.constraints.pinned.clear();
   const UnsharpResult free = unsharp_mask(hemisphere.V, hemisphere.F, options);
   EXPECT_EQ(free.fixed_vertices, 0);
   double boundary_motion = 0;
@@ -205,9 +205,9 @@ TEST(Unsharp, BadInputIsRefused) {
   }
   const Mesh sphere = test::icosphere(1.0, 1);
   UnsharpOptions options;
-  options.pinned = {sphere.num_vertices()};
+  options.constraints.pinned = {sphere.num_vertices()};
   EXPECT_THROW(unsharp_mask(sphere.V, sphere.F, options), std::invalid_argument);
-  options.pinned.clear();
+  options.constraints.pinned.clear();
   options.smoothing_iterations = -1;
   EXPECT_THROW(unsharp_mask(sphere.V, sphere.F, options), std::invalid_argument);
   options.smoothing_iterations = 1;

@@ -1,6 +1,8 @@
 // The HTML report page: self-contained, both meshes' data decoded back and compared with the
 // meshes, colours wired to the right quantities, deterministic bytes, display decimation of
-// large meshes. The page in a real browser is tested by web/tests/report_browser.mjs.
+// large meshes, results with faces of their own (edge flips). The page in a real browser is
+// tested by web/tests/report_browser.mjs.
+#include "page_data.h"
 #include "shapes.h"
 #include "test_support.h"
 
@@ -9,15 +11,18 @@
 #include "vertexflow/io.h"
 #include "vertexflow/quality.h"
 
+#include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstring>
+#include <cstdint>
+#include <map>
 #include <set>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace vertexflow {
@@ -40,6 +45,77 @@ Pair torus_pair() {
   return p;
 }
 
+// Faces with interior edges flipped as edge_flips.h flips them: (a, b, c) and (b, a, d) become
+// (a, d, c) and (d, b, c), each keeping its face index. No vertex takes part in two flips and no
+// new diagonal is an edge already, so the faces stay a closed manifold surface.
+Faces with_flipped_edges(const Faces& F, Index num_vertices) {
+  std::map<std::pair<Index, Index>, Index> face_of_edge;  // directed edge -> face
+  std::set<std::pair<Index, Index>> edges;
+  for (Index f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const Index a = F(f, k), b = F(f, (k + 1) % 3);
+      face_of_edge[{a, b}] = f;
+      edges.insert(std::minmax(a, b));
+    }
+  Faces out = F;
+  std::vector<char> used(static_cast<std::size_t>(num_vertices), 0);
+  const auto free = [&](Index v) { return !used[static_cast<std::size_t>(v)]; };
+  for (Index f = 0; f < F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const Index a = F(f, k), b = F(f, (k + 1) % 3), c = F(f, (k + 2) % 3);
+      const auto twin = face_of_edge.find({b, a});
+      if (twin == face_of_edge.end()) continue;
+      const Index g = twin->second;
+      const Index d = F(g, 0) + F(g, 1) + F(g, 2) - a - b;
+      if (!free(a) || !free(b) || !free(c) || !free(d) || edges.count(std::minmax(c, d))) continue;
+      out.row(f) << a, d, c;
+      out.row(g) << d, b, c;
+      for (const Index v : {a, b, c, d}) used[static_cast<std::size_t>(v)] = 1;
+      edges.insert(std::minmax(c, d));
+      break;
+    }
+  return out;
+}
+
+// An ellipsoid (so mean curvature varies and its colours do not saturate) and a result with a
+// bump and its own faces: near-equilateral pairs flipped into thin ones.
+Pair flipped_ellipsoid_pair(int levels) {
+  Pair p;
+  p.input = test::icosphere(1.0, levels);
+  p.input.V.col(0) *= 1.6;
+  p.input.V.col(2) *= 0.7;
+  p.result = p.input;
+  for (Index v = 0; v < p.input.num_vertices(); ++v)
+    p.result.V.row(v) *= 1.0 + 0.05 * std::sin(3 * p.input.V(v, 0)) * std::cos(2 * p.input.V(v, 1));
+  p.result.F = with_flipped_edges(p.input.F, p.input.num_vertices());
+  return p;
+}
+
+Index changed_faces(const Pair& p) {
+  Index n = 0;
+  for (Index f = 0; f < p.input.num_faces(); ++f) n += p.result.F.row(f) != p.input.F.row(f);
+  return n;
+}
+
+std::vector<std::int64_t> histogram(const Vertices& V, const Faces& F) {
+  const auto counts = summarize_quality(triangle_quality(V, F)).histogram;
+  return {counts.begin(), counts.end()};
+}
+
+// The display's faces as sets of three display vertices, each checked: in range, three
+// different corners, none twice.
+std::set<std::array<std::uint32_t, 3>> display_triples(const std::vector<std::uint32_t>& indices, Index vertices) {
+  std::set<std::array<std::uint32_t, 3>> distinct;
+  for (std::size_t f = 0; f + 2 < indices.size(); f += 3) {
+    std::array<std::uint32_t, 3> t{indices[f], indices[f + 1], indices[f + 2]};
+    for (const auto i : t) EXPECT_LT(i, static_cast<std::uint32_t>(vertices));
+    EXPECT_TRUE(t[0] != t[1] && t[1] != t[2] && t[0] != t[2]) << "collapsed face kept";
+    std::sort(t.begin(), t.end());
+    EXPECT_TRUE(distinct.insert(t).second) << "duplicate face kept";
+  }
+  return distinct;
+}
+
 std::size_t count(const std::string& text, const std::string& what) {
   std::size_t n = 0;
   for (std::size_t at = text.find(what); at != std::string::npos; at = text.find(what, at + 1)) ++n;
@@ -51,43 +127,9 @@ std::string lower(std::string s) {
   return s;
 }
 
-// The JSON inside <script id="vertexflow-data">.
-nlohmann::json page_data(const std::string& html) {
-  const std::string open = R"(<script id="vertexflow-data" type="application/json">)";
-  const std::size_t begin = html.find(open);
-  EXPECT_NE(begin, std::string::npos);
-  const std::size_t end = html.find("</script>", begin);
-  return nlohmann::json::parse(html.substr(begin + open.size(), end - begin - open.size()));
-}
-
-// An independent base64 decoder (RFC 4648), for reading the arrays back.
-std::vector<unsigned char> decode_base64(const std::string& text) {
-  static const std::string alphabet = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
-  std::vector<unsigned char> out;
-  unsigned buffer = 0;
-  int bits = 0;
-  for (const char c : text) {
-    if (c == '=') break;
-    const std::size_t value = alphabet.find(c);
-    EXPECT_NE(value, std::string::npos) << "not base64: " << c;
-    buffer = (buffer << 6) | static_cast<unsigned>(value);
-    bits += 6;
-    if (bits >= 8) {
-      bits -= 8;
-      out.push_back(static_cast<unsigned char>((buffer >> bits) & 0xFF));
-    }
-  }
-  return out;
-}
-
-template <class T>
-std::vector<T> decode_array(const nlohmann::json& field) {
-  const std::vector<unsigned char> bytes = decode_base64(field.get<std::string>());
-  EXPECT_EQ(bytes.size() % sizeof(T), 0u);
-  std::vector<T> values(bytes.size() / sizeof(T));
-  std::memcpy(values.data(), bytes.data(), values.size() * sizeof(T));
-  return values;
-}
+using test::decode_array;
+using test::decode_base64;
+using test::page_data;
 
 // The page's colour convention, written out here independently of colormap.cpp: Moreland's
 // cool-warm end points (blue 59 76 192 at -1, white 221 221 221 at 0, red 180 4 38 at +1),
@@ -156,6 +198,8 @@ TEST(HtmlReport, HoldsBothMeshesAndTheirColours) {
   EXPECT_EQ(data["display"]["faces"], nf);
   EXPECT_EQ(data["display"]["decimated"], false);
   EXPECT_EQ(data["display"]["note"], "");
+  EXPECT_FALSE(data["display"].contains("result_indices")) << "the result has the input's faces";
+  EXPECT_FALSE(data["display"].contains("result_faces"));
   EXPECT_EQ(data["labels"]["input"], "in.off");
   EXPECT_EQ(data["labels"]["result"], "out.ply");
   EXPECT_EQ(data["metrics"], nlohmann::json::parse(metrics));
@@ -316,14 +360,126 @@ TEST(HtmlReport, RefusesMismatchedMeshesAndBadMetrics) {
   const Pair p = torus_pair();
   const Mesh other = test::torus(1.0, 0.6, 40, 24);
   EXPECT_THROW(html_report(p.input, other, ""), std::invalid_argument);
-  Mesh reordered = p.result;
-  reordered.F.row(0) = reordered.F.row(0).reverse().eval();
-  EXPECT_THROW(html_report(p.input, reordered, ""), std::invalid_argument);
+  // The same vertices with a face fewer: not a result of this input (edge flips keep the count).
+  Mesh fewer = p.result;
+  fewer.F.conservativeResize(fewer.F.rows() - 1, 3);
+  try {
+    html_report(p.input, fewer, "");
+    ADD_FAILURE() << "a result with another face count was accepted";
+  } catch (const std::invalid_argument& e) {
+    const std::string message = e.what();
+    EXPECT_NE(message.find(fmt::format("{} faces", p.input.num_faces() - 1)), std::string::npos) << message;
+    EXPECT_NE(message.find("vertex and face counts"), std::string::npos) << message;
+  }
+  EXPECT_THROW(html_report(p.input, fewer, principal_curvatures(p.input.V, p.input.F),
+                           principal_curvatures(p.input.V, p.input.F), ""),
+               std::invalid_argument);
+  Mesh out_of_range = p.result;
+  out_of_range.F(3, 1) = p.result.num_vertices();
+  EXPECT_THROW(html_report(p.input, out_of_range, principal_curvatures(p.input.V, p.input.F),
+                           principal_curvatures(p.input.V, p.input.F), ""),
+               std::invalid_argument);
   EXPECT_THROW(html_report(p.input, p.result, "[1, 2]"), std::invalid_argument);
   EXPECT_THROW(html_report(p.input, p.result, "{not json"), std::invalid_argument);
   HtmlReportOptions options;
   options.max_display_faces = 0;
   EXPECT_THROW(html_report(p.input, p.result, "", options), std::invalid_argument);
+}
+
+// A result of edge flips: the same vertices, faces of its own. Its view, quality and curvature
+// are its own faces'; displacement stays per vertex.
+TEST(HtmlReport, ResultWithItsOwnFacesIsShownOnThem) {
+  const Pair p = flipped_ellipsoid_pair(3);
+  ASSERT_GT(changed_faces(p), 100);
+  const std::string html = html_report(p.input, p.result, "");
+  const nlohmann::json data = page_data(html);
+  const Index nv = p.input.num_vertices(), nf = p.input.num_faces();
+  EXPECT_EQ(data["counts"]["faces"], nf);
+  EXPECT_EQ(data["display"]["faces"], nf);
+  EXPECT_EQ(data["display"]["result_faces"], nf);
+  EXPECT_EQ(data["display"]["vertices"], nv);
+  const auto indices = decode_array<std::uint32_t>(data["display"]["indices"]);
+  const auto result_indices = decode_array<std::uint32_t>(data["display"]["result_indices"]);
+  ASSERT_EQ(indices.size(), static_cast<std::size_t>(3 * nf));
+  ASSERT_EQ(result_indices.size(), static_cast<std::size_t>(3 * nf));
+  for (Index f = 0; f < nf; ++f)
+    for (int k = 0; k < 3; ++k) {
+      ASSERT_EQ(indices[static_cast<std::size_t>(3 * f + k)], static_cast<std::uint32_t>(p.input.F(f, k)));
+      ASSERT_EQ(result_indices[static_cast<std::size_t>(3 * f + k)], static_cast<std::uint32_t>(p.result.F(f, k)));
+    }
+
+  // Quality: the result's faces, which the flips made worse than the input's faces would be.
+  const Eigen::VectorXd q_own = triangle_quality(p.result.V, p.result.F);
+  ASSERT_NE(histogram(p.result.V, p.result.F), histogram(p.result.V, p.input.F));
+  EXPECT_EQ(data["histograms"]["result"].get<std::vector<std::int64_t>>(), histogram(p.result.V, p.result.F));
+  EXPECT_EQ(data["histograms"]["input"].get<std::vector<std::int64_t>>(), histogram(p.input.V, p.input.F));
+  expect_colors(data["result"]["quality"], Eigen::VectorXd(0.5 - q_own.array()), 0.5, "result quality");
+  expect_colors(data["input"]["quality"], Eigen::VectorXd(0.5 - triangle_quality(p.input.V, p.input.F).array()), 0.5,
+                "input quality");
+
+  // Curvature of the result's own faces, visibly unlike that of the input's faces.
+  const Curvature input_curvature = principal_curvatures(p.input.V, p.input.F);
+  const Curvature own = principal_curvatures(p.result.V, p.result.F);
+  const Eigen::VectorXd H_own = own.mean();
+  const Eigen::VectorXd H_shared = principal_curvatures(p.result.V, p.input.F).mean();
+  const double limit = documented_limit(input_curvature.mean());
+  double apart = 0;
+  for (Index v = 0; v < nv; ++v)
+    apart = std::max(apart,
+                     (documented_color(H_own[v], limit) - documented_color(H_shared[v], limit)).cwiseAbs().maxCoeff());
+  ASSERT_GT(apart, 3) << "the curvature of the two face sets gives the same colours: the check below tells nothing";
+  expect_colors(data["result"]["mean_curvature"], H_own, limit, "result H");
+  const Eigen::VectorXd moved = (p.result.V - p.input.V).rowwise().norm();
+  expect_colors(data["displacement"], moved, documented_limit(moved), "displacement");
+
+  // The given curvature (each mesh's own faces') gives the same page.
+  EXPECT_TRUE(html_report(p.input, p.result, input_curvature, own, "") == html) << "not the same page";
+}
+
+// Decimated for display, the result's own faces go through the input's clusters: faces that
+// only differ in their first corner give the input's display faces, so rotated corners, and
+// flipped faces stay within the limit.
+TEST(HtmlReport, DecimatedResultMapsItsOwnFacesThroughTheSameClusters) {
+  const Mesh sphere = test::icosphere(1.0, 5);  // 20480 faces
+  Mesh rotated = sphere;
+  rotated.V *= 1.01;
+  for (Index f = 0; f < sphere.num_faces(); ++f) rotated.F.row(f) << sphere.F(f, 1), sphere.F(f, 2), sphere.F(f, 0);
+  HtmlReportOptions options;
+  options.max_display_faces = 3000;
+  const nlohmann::json data = page_data(html_report(sphere, rotated, "", options));
+  ASSERT_EQ(data["display"]["decimated"], true);
+  const Index faces = data["display"]["faces"];
+  ASSERT_EQ(data["display"]["result_faces"], faces);
+  const auto indices = decode_array<std::uint32_t>(data["display"]["indices"]);
+  const auto result_indices = decode_array<std::uint32_t>(data["display"]["result_indices"]);
+  ASSERT_EQ(result_indices.size(), static_cast<std::size_t>(3 * faces));
+  ASSERT_EQ(indices.size(), result_indices.size());
+  for (std::size_t f = 0; f < indices.size(); f += 3)
+    for (std::size_t k = 0; k < 3; ++k) ASSERT_EQ(result_indices[f + k], indices[f + (k + 1) % 3]) << f / 3;
+  // Quality is invariant to the scale and the corner order: the same colours per display face.
+  const auto q_input = decode_base64(data["input"]["quality"].get<std::string>());
+  const auto q_result = decode_base64(data["result"]["quality"].get<std::string>());
+  ASSERT_EQ(q_result.size(), static_cast<std::size_t>(3 * faces));
+  ASSERT_EQ(q_input.size(), q_result.size());
+  for (std::size_t i = 0; i < q_input.size(); ++i) EXPECT_LE(std::abs(int(q_input[i]) - int(q_result[i])), 1) << i;
+  const std::string note = data["display"]["note"];
+  EXPECT_NE(note.find(fmt::format("faces, {} of the result's own faces, ", faces)), std::string::npos) << note;
+
+  // Flipped faces: mapped, collapsed ones dropped, within the limit, and not the input's.
+  Mesh flipped = rotated;
+  flipped.F = with_flipped_edges(sphere.F, sphere.num_vertices());
+  const nlohmann::json fd = page_data(html_report(sphere, flipped, "", options));
+  const Index vertices = fd["display"]["vertices"], result_faces = fd["display"]["result_faces"];
+  EXPECT_LE(result_faces, 3000);
+  EXPECT_LE(fd["display"]["faces"].get<Index>(), 3000);
+  EXPECT_GE(result_faces, 3000 / 4);
+  const auto flipped_indices = decode_array<std::uint32_t>(fd["display"]["result_indices"]);
+  ASSERT_EQ(flipped_indices.size(), static_cast<std::size_t>(3 * result_faces));
+  EXPECT_NE(display_triples(flipped_indices, vertices),
+            display_triples(decode_array<std::uint32_t>(fd["display"]["indices"]), vertices));
+  EXPECT_EQ(decode_base64(fd["result"]["quality"].get<std::string>()).size(),
+            static_cast<std::size_t>(3 * result_faces));
+  EXPECT_EQ(decode_base64(fd["displacement"].get<std::string>()).size(), static_cast<std::size_t>(3 * vertices));
 }
 
 TEST(HtmlReport, WritesTheFileAtomically) {

@@ -1,5 +1,6 @@
 // `vertexflow report` and `vertexflow enhance --html` end to end: files written, inputs never
 // overwritten, one-line errors.
+#include "page_data.h"
 #include "test_support.h"
 
 #include "vertexflow/flow.h"
@@ -11,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cstdint>
 #include <filesystem>
 #include <set>
 #include <string>
@@ -43,10 +45,9 @@ TEST(CliReport, EnhanceWritesTheHtmlReportWithTheJsonMetrics) {
   ASSERT_FALSE(page.empty());
   // The metrics table holds the --report JSON (timings, options and all).
   const auto report = nlohmann::json::parse(test::read_text(json));
-  const std::string open = R"(<script id="vertexflow-data" type="application/json">)";
-  const std::size_t begin = page.find(open) + open.size();
-  const auto data = nlohmann::json::parse(page.substr(begin, page.find("</script>", begin) - begin));
+  const auto data = test::page_data(page);
   EXPECT_EQ(data["metrics"], report);
+  EXPECT_FALSE(data["display"].contains("result_indices")) << "the flow keeps the input's faces";
   expect_the_flow_moved_fandisk(report);
   EXPECT_EQ(data["labels"]["input"], "fandisk.off");
   EXPECT_EQ(data["labels"]["result"], "out.ply");
@@ -94,9 +95,9 @@ TEST(CliReport, EnhanceReportHoldsTheFlowsOptionsAndReport) {
   options.weights.lambda = 2;
   options.weights.mu = 0.25;
   options.weights.fairness_target = FairnessTarget::Zero;
-  options.min_quality = 0.2;
+  options.guard.min_quality = 0.2;
   options.feature_angle = 30;
-  options.fix_boundary = false;
+  options.constraints.fix_boundary = false;
   options.project_to_input = false;
   EXPECT_EQ(report["options"], nlohmann::json(options));
   for (const char* key : {"solver", "solver_tolerance", "max_halvings", "curvature"})
@@ -130,7 +131,7 @@ TEST(CliReport, UnsharpReportHoldsItsOwnSections) {
   UnsharpOptions options;
   options.weight = 0.5;
   options.smoothing_iterations = 3;
-  options.fix_boundary = false;
+  options.constraints.fix_boundary = false;
   EXPECT_EQ(report["options"], nlohmann::json(options));
   EXPECT_EQ(report["method"], "unsharp");
   EXPECT_EQ(keys(report), with_metrics({"input", "output", "method", "options", "fixed_vertices", "non_manifold",
@@ -204,16 +205,70 @@ TEST(CliReport, NeverOverwritesAnInputAndFailsOnOneLine) {
   EXPECT_FALSE(std::filesystem::exists(dir.file("r.html")));
 }
 
+// The display's faces of the result in a page: its own when it has them, else the input's.
+Faces result_faces_on_page(const nlohmann::json& data) {
+  const auto indices = test::decode_array<std::uint32_t>(
+      data["display"].contains("result_indices") ? data["display"]["result_indices"] : data["display"]["indices"]);
+  Faces F(static_cast<Index>(indices.size() / 3), 3);
+  for (std::size_t i = 0; i < indices.size(); ++i) F(static_cast<Index>(i / 3), static_cast<int>(i % 3)) = indices[i];
+  return F;
+}
+
+// Edge flips give the result faces of its own (same counts): `enhance --html` and `report` show
+// it on them, and measure it as enhance's report does.
+TEST(CliReport, EdgeFlipResultsAreReported) {
+  test::ScratchDir dir("cli-report-edge-flips");
+  const auto input = test::data_path("fandisk.off");
+  const auto out = dir.file("out.ply"), json = dir.file("r.json"), html = dir.file("r.html");
+  const auto r = run_cli("--quiet enhance " + q(input) + " " + q(out) + " --edge-flips --report " + q(json) +
+                         " --html " + q(html));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Mesh mesh = read_mesh(input), result = read_mesh(out);
+  ASSERT_EQ(result.num_faces(), mesh.num_faces());
+  ASSERT_NE(result.F, mesh.F) << "no edge flipped: the test tells nothing";
+  const auto report = nlohmann::json::parse(test::read_text(json));
+  const auto data = test::page_data(test::read_text(html));
+  EXPECT_EQ(data["metrics"], report);
+  EXPECT_EQ(result_faces_on_page(data), result.F);
+  EXPECT_EQ(data["display"]["result_faces"], result.num_faces());
+  EXPECT_EQ(data["histograms"]["result"], report["quality_result"]["histogram"]);
+
+  // `report` of the same pair: accepted, the same page and metrics (but for the timings and the
+  // method's sections, which only enhance knows).
+  const auto page = dir.file("again.html"), metrics_file = dir.file("again.json");
+  const auto again =
+      run_cli("--quiet report " + q(input) + " " + q(out) + " " + q(page) + " --json-report " + q(metrics_file));
+  ASSERT_EQ(again.exit_code, 0) << again.err;
+  EXPECT_TRUE(again.err.empty()) << again.err;
+  const auto metrics = nlohmann::json::parse(test::read_text(metrics_file));
+  for (const char* key : {"vertices", "faces", "flipped_faces", "degenerate_faces", "quality_input", "quality_result",
+                          "redistribution_rho", "edge_error_cv", "displacement_edge_lengths", "volume_change_percent"})
+    EXPECT_EQ(metrics[key], report[key]) << key;
+  auto page_data = test::page_data(test::read_text(page)), enhance_data = data;
+  page_data.erase("metrics");
+  enhance_data.erase("metrics");
+  EXPECT_TRUE(page_data == enhance_data) << "the pages differ beyond their metrics";
+}
+
 TEST(CliReport, ResultOfAnotherMeshIsAnError) {
   test::ScratchDir dir("cli-report-mismatch");
-  const auto r = run_cli("report " + q(test::data_path("fandisk.off")) + " " + q(test::data_path("torus.obj")) + " " +
-                         q(dir.file("r.html")));
-  EXPECT_EQ(r.exit_code, 1);
-  EXPECT_EQ(r.err.rfind("vertexflow: error: " + test::data_path("torus.obj").string() + ": not the connectivity of", 0),
-            0u)
-      << r.err;
-  EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
-  EXPECT_FALSE(std::filesystem::exists(dir.file("r.html")));
+  // Another vertex count, and the input's vertices with a face fewer: neither is a result of it.
+  Mesh fewer = read_mesh(test::data_path("fandisk.off"));
+  fewer.F.conservativeResize(fewer.F.rows() - 1, 3);
+  write_mesh(dir.file("fewer.off"), fewer);
+  ASSERT_EQ(read_mesh(dir.file("fewer.off")).num_vertices(), fewer.num_vertices());
+  for (const std::filesystem::path& other : {test::data_path("torus.obj"), dir.file("fewer.off")}) {
+    const auto r =
+        run_cli("report " + q(test::data_path("fandisk.off")) + " " + q(other) + " " + q(dir.file("r.html")));
+    EXPECT_EQ(r.exit_code, 1);
+    EXPECT_EQ(r.err.rfind("vertexflow: error: " + other.string() + ": not a result of " +
+                              test::data_path("fandisk.off").string() + " (",
+                          0),
+              0u)
+        << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+    EXPECT_FALSE(std::filesystem::exists(dir.file("r.html")));
+  }
 }
 
 }  // namespace

@@ -64,8 +64,10 @@ TEST(ReportJson, CurvatureOptionsEveryField) {
 
 TEST(ReportJson, FlowOptionsEveryField) {
   FlowOptions options;
-  auto& [weights, d_percentile, iterations, project_to_input, feature_angle, fix_boundary, pinned, refuse_non_manifold,
-         max_halvings, min_quality, sliver_floor, curvature, solver, solver_tolerance, density] = options;
+  auto& [weights, d_percentile, iterations, project_to_input, feature_angle, constraints, refuse_non_manifold, guard,
+         curvature, solver, solver_tolerance, density] = options;
+  auto& [fix_boundary, pinned] = constraints;
+  auto& [min_quality, sliver_floor, max_halvings] = guard;
   weights.lambda = 0.25;
   weights.mu = 0.75;
   weights.epsilon = 1e-4;
@@ -161,7 +163,8 @@ TEST(ReportJson, FlowReportEveryFieldInItsSection) {
 
 TEST(ReportJson, UnsharpOptionsAndResultEveryField) {
   UnsharpOptions options;
-  auto& [weight, smoothing_iterations, fix_boundary, pinned, refuse_non_manifold] = options;
+  auto& [weight, smoothing_iterations, constraints, refuse_non_manifold] = options;
+  auto& [fix_boundary, pinned] = constraints;
   weight = 0.5;
   smoothing_iterations = 7;
   fix_boundary = false;

@@ -3,9 +3,10 @@
 // the data in <script id="vertexflow-data" type="application/json">. Nothing is fetched.
 //
 // Data layout (all binary arrays base64, little-endian): display.indices uint32 (3 per face,
-// shared by both meshes: the flow keeps connectivity), <mesh>.positions float32 (3 per vertex,
-// relative to `offset`), <mesh>.mean_curvature and displacement RGB bytes per vertex,
-// <mesh>.quality RGB bytes per face.
+// shared by both meshes: the flow keeps connectivity), display.result_indices the result's own
+// faces when it has them (edge flips: same vertices, other faces; absent otherwise),
+// <mesh>.positions float32 (3 per vertex, relative to `offset`), <mesh>.mean_curvature and
+// displacement RGB bytes per vertex, <mesh>.quality RGB bytes per face of that mesh's faces.
 import {
   BufferAttribute,
   BufferGeometry,
@@ -279,10 +280,12 @@ function showLegend(data, name) {
 
 function main() {
   const data = JSON.parse(document.getElementById('vertexflow-data').textContent);
+  const ownFaces = data.display.result_indices !== undefined;
   document.getElementById('title').textContent = data.title;
   document.getElementById('subtitle').textContent =
     `${data.labels.input} vs ${data.labels.result}: ${data.counts.vertices.toLocaleString('en-US')} vertices, ` +
-    `${data.counts.faces.toLocaleString('en-US')} faces`;
+    `${data.counts.faces.toLocaleString('en-US')} faces` +
+    (ownFaces ? '; the result has faces of its own (edge flips)' : '');
   document.getElementById('caption-input').textContent = `Input: ${data.labels.input}`;
   document.getElementById('caption-result').textContent = `Result: ${data.labels.result}`;
   const notes = document.getElementById('notes');
@@ -292,19 +295,22 @@ function main() {
   document.getElementById('metrics').appendChild(metricsTable(data.metrics, data.labels));
 
   const indices = uint32FromBase64(data.display.indices);
+  const resultIndices = ownFaces ? uint32FromBase64(data.display.result_indices) : indices;
   const displacement = bytesFromBase64(data.displacement);
   const camera = new PerspectiveCamera(35, 1, 1e-3, 1e3);
   let views;
   try {
     views = [
       new View(document.getElementById('view-input'), data.input, indices, displacement, camera),
-      new View(document.getElementById('view-result'), data.result, indices, displacement, camera),
+      new View(document.getElementById('view-result'), data.result, resultIndices, displacement, camera),
     ];
   } catch (error) {
     notes.appendChild(element('p', { class: 'error' }, `3D views unavailable (WebGL): ${error.message}`));
     document.body.dataset.ready = 'error';
     return;
   }
+  // For the browser test: the faces each view draws.
+  document.body.dataset.faces = views.map((view) => view.geometry.index.count / 3).join(' ');
 
   // Both views look at the input's bounding sphere; positions are already centred on it.
   const sphere = views[0].geometry.boundingSphere ?? new Sphere();

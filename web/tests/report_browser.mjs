@@ -3,13 +3,15 @@
 //
 //   node web/tests/report_browser.mjs --cli build/bin/vertexflow --data data --work DIR [--shots]
 //
-// It writes two reports with the CLI (`enhance --html` on fandisk; `report` with a lowered
-// display limit, so the decimated path is drawn too), opens each from file:// with every
-// non-file request refused, and checks: no console errors or page errors, no network request,
-// both canvases show a mesh (pixels that are not background), and on the first report: the
-// wireframe toggle and each colour map change both views, the curvature map has red and blue,
-// and dragging the input view turns the result view too. Prints one line per check and
-// "N passed, M failed"; exit 1 on a failure.
+// It writes four reports with the CLI: `enhance --html` on fandisk; `report` with a lowered
+// display limit, so the decimated path is drawn too; and the same two for an `--edge-flips`
+// result, which has faces of its own. It opens each from file:// with every non-file request
+// refused, and checks: no console errors or page errors, no network request, both canvases
+// show a mesh (pixels that are not background), each view draws its own mesh's display faces,
+// and on the first report: the wireframe toggle and each colour map change both views, the
+// curvature map has red and blue, and dragging the input view turns the result view too; on
+// the edge-flip report: the per-face quality map changes both views. Prints one line per check
+// and "N passed, M failed"; exit 1 on a failure.
 import { execFileSync } from 'node:child_process';
 import { statSync } from 'node:fs';
 import path from 'node:path';
@@ -25,8 +27,13 @@ const mesh = path.join(dataDir, 'fandisk.off');
 const enhanced = path.join(work, 'fandisk_enhanced.ply');
 const fullReport = path.join(work, 'fandisk.html');
 const decimatedReport = path.join(work, 'fandisk_decimated.html');
+const flipped = path.join(work, 'fandisk_flipped.ply');
+const flipsReport = path.join(work, 'fandisk_flips.html');
+const flipsDecimatedReport = path.join(work, 'fandisk_flips_decimated.html');
 run('enhance', mesh, enhanced, '--html', fullReport);
 run('report', mesh, enhanced, decimatedReport, '--max-display-faces', '3000');
+run('enhance', mesh, flipped, '--edge-flips', '--html', flipsReport);
+run('report', mesh, flipped, flipsDecimatedReport, '--max-display-faces', '3000');
 
 // One screenshot of the strip holding both canvases (few screenshots: each costs a software
 // render and a PNG round trip), and where each canvas lies in it.
@@ -93,7 +100,7 @@ async function afterRedraw(page, action) {
 
 const VIEWS = ['input', 'result'];
 
-async function testReport(browser, file, { decimated, interact }) {
+async function testReport(browser, file, { decimated, interact, ownFaces, quality = false }) {
   const name = path.basename(file);
   const { context, page, requests, errors } = await offlinePage(browser, { width: 900, height: 700 });
 
@@ -111,7 +118,21 @@ async function testReport(browser, file, { decimated, interact }) {
     check(stats.foreground > 0.03 * stats.total, `${name}: ${VIEWS[k]} canvas shows a mesh`,
       `${stats.foreground} of ${stats.total} pixels not background`));
 
+  // The faces each view draws: the input's display faces, and the result's own when it has them.
+  const display = await page.evaluate(() => JSON.parse(document.getElementById('vertexflow-data').textContent).display);
+  check((display.result_indices !== undefined) === ownFaces,
+    `${name}: the result ${ownFaces ? 'has its own faces' : 'shares the input\'s faces'}`);
+  const drawn = await page.evaluate(() => document.body.dataset.faces);
+  check(drawn === `${display.faces} ${display.result_faces ?? display.faces}`,
+    `${name}: each view draws its own mesh's faces`, `drawn ${drawn}`);
+
   if (interact) await testInteraction(page, name, plain);
+  if (quality) {
+    await afterRedraw(page, () => page.locator('#colormap').selectOption('quality'));
+    const stats = await analyse(page, await shoot(page, `${name}.quality`), plain);
+    check(stats.every((s) => s.changed > 0.01 * s.total), `${name}: colour map quality changes both views`,
+      stats.map((s) => s.changed).join(' and '));
+  }
 
   const note = await page.locator('#decimation-note').count();
   check(note === (decimated ? 1 : 0), `${name}: decimation note ${decimated ? 'shown' : 'absent'}`);
@@ -165,8 +186,10 @@ const browser = await chromium.launch({
   args: ['--no-sandbox', '--disable-dev-shm-usage', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
 });
 try {
-  await testReport(browser, fullReport, { decimated: false, interact: true });
-  await testReport(browser, decimatedReport, { decimated: true, interact: false });
+  await testReport(browser, fullReport, { decimated: false, interact: true, ownFaces: false });
+  await testReport(browser, decimatedReport, { decimated: true, interact: false, ownFaces: false });
+  await testReport(browser, flipsReport, { decimated: false, interact: false, ownFaces: true, quality: true });
+  await testReport(browser, flipsDecimatedReport, { decimated: true, interact: false, ownFaces: true });
 } catch (error) {
   check(false, 'browser test ran to the end', error.stack ?? String(error));
 } finally {

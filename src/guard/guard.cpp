@@ -1,7 +1,8 @@
 #include "guard.h"
 
-#include "surface_projection.h"
 #include "vertexflow/quality.h"
+
+#include <fmt/format.h>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -9,6 +10,7 @@
 #include <algorithm>
 #include <iterator>
 #include <limits>
+#include <stdexcept>
 
 namespace vertexflow {
 namespace {
@@ -104,17 +106,16 @@ std::vector<Index> bad_among(const std::vector<Index>& faces, const GuardCriteri
 // max_halvings-th halving, so the loop is finite whatever the geometry: it ends when a round
 // finds no corner to shorten. `bad_list` (sorted) holds every bad face of X. Marks in
 // `shortened` the vertices it halved.
-void shorten_until_good(Vertices& X, const Vertices& anchor, const Vertices& input, const GuardCriteria& criteria,
-                        std::vector<Index> bad_list, const std::vector<char>& fixed, const Topology& topology,
-                        const SurfaceFeatures& features, const FlowOptions& options, std::vector<char>& shortened) {
-  const Faces& F = criteria.F;
+void shorten_until_good(Vertices& X, const Vertices& anchor, const GuardCriteria& criteria, std::vector<Index> bad_list,
+                        const std::vector<char>& fixed, const Topology& topology, const GuardOptions& options,
+                        const Reprojection& reproject, std::vector<char>& shortened) {
   const auto n = static_cast<std::size_t>(X.rows());
   const Vertices displacement = X - anchor;
   std::vector<double> step(n, 1.0);
   std::vector<int> halvings(n, 0);
   std::vector<char> chosen(n, 0);
   while (!bad_list.empty()) {
-    std::vector<Index> moved, reproject;
+    std::vector<Index> moved, to_reproject;
     for (const Index f : bad_list) {
       const Index i = corner_to_shorten(criteria, f, X, anchor, displacement, step, fixed);
       if (i < 0 || chosen[static_cast<std::size_t>(i)]) continue;
@@ -130,9 +131,9 @@ void shorten_until_good(Vertices& X, const Vertices& anchor, const Vertices& inp
       shortened[v] = 1;
       X.row(i) = anchor.row(i) + step[v] * displacement.row(i);
       // Back onto the surface, except at step 0: the anchor itself, exactly.
-      if (step[v] != 0.0 && options.project_to_input) reproject.push_back(i);
+      if (step[v] != 0.0 && reproject) to_reproject.push_back(i);
     }
-    project_near_vertices(X, reproject, input, F, topology, features);
+    if (reproject) reproject(X, to_reproject);
     // Only the faces around the moved vertices can have changed; the other bad faces stay bad.
     const std::vector<Index> faces = faces_around(moved, topology);
     std::vector<Index> unchanged;
@@ -145,7 +146,8 @@ void shorten_until_good(Vertices& X, const Vertices& anchor, const Vertices& inp
 
 }  // namespace
 
-GuardCriteria guard_criteria(const Vertices& before, const Faces& F, double min_quality, double sliver_floor) {
+GuardCriteria guard_criteria(const Vertices& before, const Faces& F, const GuardOptions& options) {
+  const double min_quality = options.min_quality, sliver_floor = options.sliver_floor;
   const double diagonal = bounding_box(before).diagonal();
   const Eigen::VectorXd quality = triangle_quality(before, F);
   // The worst input face around each vertex; a face's floor is the worst of its corners'.
@@ -166,13 +168,14 @@ GuardCriteria guard_criteria(const Vertices& before, const Faces& F, double min_
   return criteria;
 }
 
-void guard(Vertices& X, const Vertices& anchor, const Vertices& input, const GuardCriteria& criteria,
-           const std::vector<char>& fixed, const Topology& topology, const SurfaceFeatures& features,
-           const FlowOptions& options, std::vector<char>& shortened, FlowReport& report) {
+GuardCounts guard(Vertices& X, const Vertices& anchor, const GuardCriteria& criteria, const std::vector<char>& fixed,
+                  const Topology& topology, const GuardOptions& options, const Reprojection& reproject,
+                  std::vector<char>& shortened) {
   std::vector<char> bad = bad_faces(criteria, X);
-  report.flipped_before_guard += static_cast<Index>(std::count(bad.begin(), bad.end(), kFlippedOrDegenerate));
-  report.low_quality_before_guard += static_cast<Index>(std::count(bad.begin(), bad.end(), kLowQuality));
-  if (std::none_of(bad.begin(), bad.end(), [](char b) { return b != 0; })) return;
+  GuardCounts counts;
+  counts.flipped_before_guard = static_cast<Index>(std::count(bad.begin(), bad.end(), kFlippedOrDegenerate));
+  counts.low_quality_before_guard = static_cast<Index>(std::count(bad.begin(), bad.end(), kLowQuality));
+  if (std::none_of(bad.begin(), bad.end(), [](char b) { return b != 0; })) return counts;
   const Vertices target = X;
   const auto n = static_cast<std::size_t>(X.rows());
   std::vector<Index> bad_list;
@@ -180,8 +183,7 @@ void guard(Vertices& X, const Vertices& anchor, const Vertices& input, const Gua
     if (bad[static_cast<std::size_t>(f)]) bad_list.push_back(f);
   }
   std::vector<char> short_of_target(n, 0);
-  shorten_until_good(X, anchor, input, criteria, std::move(bad_list), fixed, topology, features, options,
-                     short_of_target);
+  shorten_until_good(X, anchor, criteria, std::move(bad_list), fixed, topology, options, reproject, short_of_target);
   // Further passes offer every vertex left short of its target its whole move again, from where
   // it is now: once its neighbours have moved, a move that flipped a sliver often no longer
   // does. Each pass starts and ends with no bad face (kPassGainStop says when they stop).
@@ -195,8 +197,8 @@ void guard(Vertices& X, const Vertices& anchor, const Vertices& input, const Gua
     }
     std::vector<char> shortened_again(n, 0);
     // X has no bad face: only faces around the retried vertices can be bad in `retry`.
-    shorten_until_good(retry, X, input, criteria, bad_among(faces_around(retried, topology), criteria, retry), fixed,
-                       topology, features, options, shortened_again);
+    shorten_until_good(retry, X, criteria, bad_among(faces_around(retried, topology), criteria, retry), fixed, topology,
+                       options, reproject, shortened_again);
     std::size_t reached = 0;
     for (const Index i : retried) {
       const auto v = static_cast<std::size_t>(i);
@@ -209,6 +211,22 @@ void guard(Vertices& X, const Vertices& anchor, const Vertices& input, const Gua
     if (reached * kPassGainStop < retried.size()) break;
   }
   for (std::size_t v = 0; v < n; ++v) shortened[v] = shortened[v] || short_of_target[v];
+  return counts;
+}
+
+void validate_guard_options(const GuardOptions& options, const char* what) {
+  if (!(options.min_quality >= 0 && options.min_quality <= 1))
+    throw std::invalid_argument(std::string(what) + ": min_quality must be in [0, 1]");
+  if (!(options.sliver_floor >= 0 && options.sliver_floor <= 1))
+    throw std::invalid_argument(std::string(what) + ": sliver_floor must be in [0, 1]");
+  if (options.max_halvings < 1) throw std::invalid_argument(std::string(what) + ": max_halvings must be at least 1");
+}
+
+void validate_vertex_constraints(const VertexConstraints& constraints, Index num_vertices, const char* what) {
+  if (num_vertices < 0) return;
+  for (const Index p : constraints.pinned)
+    if (p < 0 || p >= num_vertices)
+      throw std::invalid_argument(fmt::format("{}: pinned vertex {} is out of range [0, {})", what, p, num_vertices));
 }
 
 }  // namespace vertexflow

@@ -1,0 +1,173 @@
+// The enhance engine: one function that chooses and runs an enhance mode (the paper's flow, the
+// flow on a reference, reference mode's fit, smooth mode, the unsharp baseline), the optional
+// edge flips after it, and the provenance line, with every "this option applies to that mode
+// only" rule in one place. The CLI's `enhance`, the batch engine (batch.h) and the Python
+// module's enhance/enhance_file/batch are front ends of this call: they parse, read, write and
+// print, and give the same bytes for the same options.
+//
+// Modes (provenance.h's EnhanceMode), chosen by EnhanceOptions and whether a reference is given:
+//   method flow,    surface input,  no reference             Flow           vertex_flow (flow.h)
+//   method flow,    surface input,  reference, method fit    ReferenceFit   fit_to_reference (fit.h)
+//   method flow,    surface input,  reference, method flow   ReferenceFlow  vertex_flow_on_reference
+//   method flow,    surface smooth, no reference             Smooth         fit_to_smooth_surface
+//   method unsharp, surface input,  no reference             Unsharp        unsharp_mask (unsharp.h)
+// Other combinations are refused (validate_enhance_options).
+//
+// Units and conventions are those of the methods' headers: lengths in the mesh's units, the
+// result the same up to rounding for any rigid motion or uniform scale of the input (and the
+// reference with it), identical bytes for any thread count.
+#pragma once
+
+#include "vertexflow/edge_flips.h"
+#include "vertexflow/fit.h"
+#include "vertexflow/flow.h"
+#include "vertexflow/guard.h"
+#include "vertexflow/provenance.h"
+#include "vertexflow/reference_surface.h"
+#include "vertexflow/unsharp.h"
+
+#include <nlohmann/json.hpp>
+
+#include <functional>
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace vertexflow {
+
+/// `--method`: the paper's flow (and the modes built on its options) or the unsharp baseline.
+enum class EnhanceMethod { Flow, Unsharp };
+/// `--surface`: what the vertices approximate without a reference.
+enum class EnhanceSurface { Input, Smooth };
+/// `--reference-method`: what is done with a reference.
+enum class ReferenceMethod { Fit, Flow };
+
+/// Everything one enhance run takes besides the meshes. The options that several modes share
+/// are set once here (constraints, guard, refuse_non_manifold, feature_angle, max_rounds); the
+/// engine writes them into the chosen method's options, whose own copies of them must be left
+/// at their defaults (validate_enhance_options refuses a change there, which would be ignored).
+struct EnhanceOptions {
+  EnhanceMethod method = EnhanceMethod::Flow;
+  EnhanceSurface surface = EnhanceSurface::Input;
+  ReferenceMethod reference_method = ReferenceMethod::Fit;
+
+  /// Every mode: boundary and pinned vertices stay where they are.
+  VertexConstraints constraints;
+  /// Flow, ReferenceFlow, ReferenceFit, Smooth (the unsharp baseline has no guard); also the
+  /// quality floor of the edge flips' new faces (EdgeFlipOptions::min_quality).
+  GuardOptions guard;
+  /// Flow, ReferenceFlow, Unsharp: refuse a non-manifold or inconsistently oriented mesh
+  /// instead of running on its manifold split (manifold_split.h).
+  bool refuse_non_manifold = false;
+  /// Flow, ReferenceFlow (FlowOptions::feature_angle), Smooth (SmoothSurfaceOptions), degrees.
+  double feature_angle = 40.0;
+  /// ReferenceFit, Smooth: rounds of solve and guard at most; none keeps each mode's default
+  /// (FitOptions::max_rounds 10, SmoothFitOptions's 1).
+  std::optional<int> max_rounds;
+  /// Smooth: fit even an input that looks decimated or whose provenance records a fit
+  /// (SmoothFitOptions::max_poor_face_fraction 1, already_fitted false).
+  bool assume_on_surface = false;
+
+  /// Flow, ReferenceFlow: the flow's own options (weights, curvature, solver, projection,
+  /// density passes).
+  FlowOptions flow;
+  /// ReferenceFit: the fit's own options (samples, weights, tolerance, seed).
+  FitOptions fit;
+  /// Smooth: the estimate's segments, the decimation threshold and the fit's weights.
+  SmoothFitOptions smooth;
+  /// Unsharp: weight and smoothing iterations.
+  UnsharpOptions unsharp;
+
+  /// Flow, ReferenceFit, Smooth: after the method, flip edges towards the reference (or the
+  /// smooth estimate of the input) (edge_flips.h). The one option that changes the faces.
+  bool edge_flips = false;
+  /// With edge_flips in ReferenceFit: cycles of flips and refit (the other modes flip once).
+  int flip_cycles = 2;
+};
+
+/// The mode `options` choose, with or without a reference (table above). Throws
+/// EnhanceOptionError for a combination the table does not have.
+EnhanceMode enhance_mode(const EnhanceOptions& options, bool has_reference);
+
+/// The report's name of a mode: "flow", "reference", "reference-flow", "smooth", "unsharp".
+const char* enhance_mode_name(EnhanceMode mode);
+
+/// The options each method runs with: the method's own options with the shared ones written in.
+FlowOptions effective_flow_options(const EnhanceOptions& options);
+FitOptions effective_fit_options(const EnhanceOptions& options);
+/// `already_fitted` comes from the input's provenance (find_fit_provenance), unless
+/// assume_on_surface.
+SmoothFitOptions effective_smooth_options(const EnhanceOptions& options, bool already_fitted = false);
+UnsharpOptions effective_unsharp_options(const EnhanceOptions& options);
+
+/// How an option is named in a message: as the CLI's flag ("--lambda"), the Python keyword
+/// ("lam") or the C++ member ("flow.weights.lambda").
+enum class OptionNaming { Cli, Python, Cpp };
+
+/// An option that does not apply to the chosen mode, or a combination of options that do not
+/// go together. what() is one line, naming the option as the front end calls it.
+class EnhanceOptionError : public std::invalid_argument {
+ public:
+  using std::invalid_argument::invalid_argument;
+};
+
+/// Checks `options` for a run with or without a reference on a mesh of `num_vertices`
+/// vertices (-1: unknown, pins are not checked): the mode exists (enhance_mode), every option
+/// that does not apply to the mode is at its default (the table of enhance_options.h says which
+/// apply where), flip_cycles only with edge_flips, no edge flips with Unsharp or ReferenceFlow,
+/// the methods' own copies of the shared options untouched, and then the method's own ranges
+/// (validate_flow_options, the fit's, the unsharp mask's). Throws EnhanceOptionError (a mode
+/// rule) or std::invalid_argument (a range), naming the option as `naming` says.
+void validate_enhance_options(const EnhanceOptions& options, bool has_reference, Index num_vertices = -1,
+                              OptionNaming naming = OptionNaming::Cpp);
+
+/// Where the engine reports progress: `phase` gets one line per step (what runs, then what it
+/// measured and how long it took), `warning` one line per warning (also in
+/// EnhanceResult::warnings). Either may be empty.
+struct EnhanceCallbacks {
+  std::function<void(const std::string&)> phase;
+  std::function<void(const std::string&)> warning;
+};
+
+struct EnhanceResult {
+  /// The result: the input's faces (or the flipped faces: same count, each face keeping its
+  /// index, edge_flips.h), its colours, and its comments with this run's provenance line
+  /// appended (provenance.h).
+  Mesh mesh;
+  EnhanceMode mode = EnhanceMode::Flow;
+  /// The report's method sections: "method", "options", what the method reported (solver,
+  /// guard, fit, non_manifold, ...), "seconds" of its phases, "edge_flips", "provenance", and
+  /// "reference_trees_built" in the reference modes. The front ends add the files, the read and
+  /// write times and the metrics (enhance_metrics).
+  nlohmann::json report;
+  /// This run's provenance line (also the last of mesh.comments).
+  std::string provenance;
+  /// One line each, without a file name: a non-manifold input run on its split, smooth mode
+  /// holding its input, ...
+  std::vector<std::string> warnings;
+};
+
+/// Runs the mode `options` choose on `mesh` (its V, F, colours and comments; the comments'
+/// provenance lines let smooth mode hold an input that an earlier fit placed off its surface),
+/// with `reference` for the reference modes (nullptr otherwise). Validates first
+/// (validate_enhance_options, OptionNaming::Cpp) and throws as the chosen method does
+/// (std::invalid_argument for a mesh it refuses).
+EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const EnhanceOptions& options,
+                      const EnhanceCallbacks& callbacks = {});
+
+/// The metrics of docs/metrics.md for an enhance result against its input: counts, flipped and
+/// degenerate faces (flipped per face index when the faces differ, edge_flips.h), quality,
+/// displacement and drift in mean input edge lengths, redistribution rho, edge-error CV, |H|
+/// p95, volume change; with `reference`, "distance_to_reference": both meshes' two-sided mean,
+/// RMS and Hausdorff distance to it, in the meshes' units. Each mesh's curvature is computed
+/// once; pass `curvatures` to receive them (for the HTML report). Throws CompareError
+/// (compare.h) for a mesh compare_meshes refuses.
+struct EnhanceCurvatures {
+  Curvature input;
+  Curvature result;
+};
+nlohmann::json enhance_metrics(const Mesh& input, const Mesh& result, const ReferenceSurface* reference = nullptr,
+                               EnhanceCurvatures* curvatures = nullptr);
+
+}  // namespace vertexflow

@@ -1,0 +1,448 @@
+// The enhance engine (enhance.h): the mode rules, the run of one mode, the edge flips after it,
+// and the provenance line.
+#include "vertexflow/enhance.h"
+
+#include "vertexflow/enhance_options.h"
+#include "vertexflow/report_json.h"
+#include "vertexflow/timing.h"
+#include "vertexflow/topology.h"
+
+#include <fmt/format.h>
+
+#include <utility>
+
+namespace vertexflow {
+namespace {
+
+// How a mode is called in a message, as each front end writes it.
+std::string mode_display(EnhanceMode mode, OptionNaming naming) {
+  const bool cli = naming == OptionNaming::Cli, python = naming == OptionNaming::Python;
+  switch (mode) {
+    case EnhanceMode::Flow:
+      return "the paper's flow";
+    case EnhanceMode::ReferenceFit:
+      return cli ? "--reference" : python ? "reference=(V, F)" : "a reference fit";
+    case EnhanceMode::ReferenceFlow:
+      return cli ? "--reference-method flow" : python ? "reference_method='flow'" : "reference_method Flow";
+    case EnhanceMode::Smooth:
+      return cli ? "--surface smooth" : python ? "surface='smooth'" : "surface Smooth";
+    case EnhanceMode::Unsharp:
+      return cli ? "--method unsharp" : python ? "method='unsharp'" : "method Unsharp";
+  }
+  return "?";
+}
+
+std::string name_of(std::string_view python_name, OptionNaming naming) {
+  return option_display_name(*find_enhance_option(python_name), naming);
+}
+
+[[noreturn]] void refuse(const std::string& what) {
+  throw EnhanceOptionError(what);
+}
+
+// Throws if `value` is not the default of `reference_value` (a method's copy of a shared
+// option): the engine would overwrite it.
+template <typename T>
+void require_default(const T& value, const T& default_value, const char* member, const char* shared) {
+  if (!(value == default_value))
+    refuse(fmt::format("{} is set by EnhanceOptions::{} for every mode; leave it at its default", member, shared));
+}
+
+void require_shared_untouched(const EnhanceOptions& o) {
+  const FlowOptions flow;
+  const FitOptions fit;
+  const SmoothFitOptions smooth;
+  const UnsharpOptions unsharp;
+  require_default(o.flow.constraints.fix_boundary, flow.constraints.fix_boundary, "flow.constraints", "constraints");
+  require_default(o.flow.constraints.pinned, flow.constraints.pinned, "flow.constraints", "constraints");
+  require_default(o.fit.constraints.fix_boundary, fit.constraints.fix_boundary, "fit.constraints", "constraints");
+  require_default(o.fit.constraints.pinned, fit.constraints.pinned, "fit.constraints", "constraints");
+  require_default(o.smooth.fit.constraints.fix_boundary, smooth.fit.constraints.fix_boundary, "smooth.fit.constraints",
+                  "constraints");
+  require_default(o.smooth.fit.constraints.pinned, smooth.fit.constraints.pinned, "smooth.fit.constraints",
+                  "constraints");
+  require_default(o.unsharp.constraints.fix_boundary, unsharp.constraints.fix_boundary, "unsharp.constraints",
+                  "constraints");
+  require_default(o.unsharp.constraints.pinned, unsharp.constraints.pinned, "unsharp.constraints", "constraints");
+  for (const auto& [guard, member] : {std::pair{&o.flow.guard, "flow.guard"}, std::pair{&o.fit.guard, "fit.guard"},
+                                      std::pair{&o.smooth.fit.guard, "smooth.fit.guard"}}) {
+    require_default(guard->min_quality, GuardOptions{}.min_quality, member, "guard");
+    require_default(guard->sliver_floor, GuardOptions{}.sliver_floor, member, "guard");
+    require_default(guard->max_halvings, GuardOptions{}.max_halvings, member, "guard");
+  }
+  require_default(o.flow.feature_angle, flow.feature_angle, "flow.feature_angle", "feature_angle");
+  require_default(o.smooth.surface.feature_angle, smooth.surface.feature_angle, "smooth.surface.feature_angle",
+                  "feature_angle");
+  require_default(o.flow.refuse_non_manifold, flow.refuse_non_manifold, "flow.refuse_non_manifold",
+                  "refuse_non_manifold");
+  require_default(o.unsharp.refuse_non_manifold, unsharp.refuse_non_manifold, "unsharp.refuse_non_manifold",
+                  "refuse_non_manifold");
+  require_default(o.fit.max_rounds, fit.max_rounds, "fit.max_rounds", "max_rounds");
+  require_default(o.smooth.fit.max_rounds, smooth.fit.max_rounds, "smooth.fit.max_rounds", "max_rounds");
+  require_default(o.smooth.max_poor_face_fraction, smooth.max_poor_face_fraction, "smooth.max_poor_face_fraction",
+                  "assume_on_surface");
+  require_default(o.smooth.already_fitted, smooth.already_fitted, "smooth.already_fitted",
+                  "assume_on_surface (the engine reads the input's provenance)");
+}
+
+EnhanceMode mode_of(const EnhanceOptions& o, bool has_reference, OptionNaming naming) {
+  const bool unsharp = o.method == EnhanceMethod::Unsharp, smooth = o.surface == EnhanceSurface::Smooth;
+  if (unsharp && smooth)
+    refuse(name_of("surface", naming) + " smooth and " + mode_display(EnhanceMode::Unsharp, naming) +
+           " exclude each other");
+  if (!has_reference) {
+    if (o.reference_method != ReferenceMethod::Fit)
+      refuse(name_of("reference_method", naming) + " applies to a reference only");
+    return unsharp ? EnhanceMode::Unsharp : smooth ? EnhanceMode::Smooth : EnhanceMode::Flow;
+  }
+  const std::string reference = naming == OptionNaming::Cli ? "--reference" : "reference";
+  if (unsharp) refuse(reference + " and " + mode_display(EnhanceMode::Unsharp, naming) + " exclude each other");
+  if (smooth) refuse(reference + " and " + mode_display(EnhanceMode::Smooth, naming) + " exclude each other");
+  return o.reference_method == ReferenceMethod::Flow ? EnhanceMode::ReferenceFlow : EnhanceMode::ReferenceFit;
+}
+
+using Callback = std::function<void(const std::string&)>;
+
+void tell(const Callback& callback, const std::string& line) {
+  if (callback) callback(line);
+}
+
+// Collects warnings for the result and passes them on.
+struct Warnings {
+  const EnhanceCallbacks& callbacks;
+  std::vector<std::string>& lines;
+  void operator()(std::string line) const {
+    tell(callbacks.warning, line);
+    lines.push_back(std::move(line));
+  }
+};
+
+void warn_about_split(Index held, Index reoriented, Index cut, const Warnings& warn) {
+  if (held + reoriented + cut > 0)
+    warn(fmt::format(
+        "the mesh is not manifold or not consistently oriented: {} vertices held (their faces form more than one fan), "
+        "{} faces reoriented, {} edges treated as boundaries; --strict refuses such meshes",
+        held, reoriented, cut));
+}
+
+struct MethodRun {
+  Vertices V;
+  nlohmann::json report;
+};
+
+MethodRun run_flow(const Mesh& mesh, const ReferenceSurface* reference, const FlowOptions& options,
+                   const EnhanceCallbacks& callbacks, const Warnings& warn) {
+  FlowResult result = reference
+                          ? vertex_flow_on_reference(mesh.V, mesh.F, reference->vertices(), reference->faces(), options)
+                          : vertex_flow(mesh.V, mesh.F, build_topology(mesh.F, mesh.num_vertices()), options);
+  const FlowReport& r = result.report;
+  tell(callbacks.phase, fmt::format("curvature {:.3f} s, assembly {:.3f} s, solve {:.3f} s, projection {:.3f} s, "
+                                    "guard {:.3f} s; {} vertices limited by the guard",
+                                    r.seconds_curvature, r.seconds_assembly, r.seconds_solve, r.seconds_projection,
+                                    r.seconds_guard, r.limited_vertices));
+  if (options.density.passes > 0)
+    tell(callbacks.phase, fmt::format("{} density passes {:.3f} s; {} vertices limited by their guard",
+                                      options.density.passes, r.seconds_density, r.density_limited_vertices));
+  warn_about_split(r.held_non_manifold_vertices, r.reoriented_faces, r.cut_edges, warn);
+  MethodRun run;
+  run.report = r;
+  run.report["options"] = options;
+  run.V = std::move(result.V);
+  return run;
+}
+
+MethodRun run_fit(const Mesh& mesh, const ReferenceSurface& reference, const FitOptions& options,
+                  const EnhanceCallbacks& callbacks) {
+  FitResult result = fit_to_reference(mesh.V, mesh.F, reference, options);
+  const FitReport& r = result.report;
+  tell(callbacks.phase,
+       fmt::format("fitted in {} rounds{}: RMS distance {:.6g} -> {:.6g}; tree {:.3f} s, queries {:.3f} s, solve "
+                   "{:.3f} s, guard {:.3f} s; {} vertices limited by the guard",
+                   r.rounds, r.converged ? "" : " (max-rounds reached)", r.rms_distance.front(), r.rms_distance.back(),
+                   r.seconds_tree, r.seconds_queries, r.seconds_solve, r.seconds_guard, r.limited_vertices));
+  MethodRun run;
+  run.report = r;
+  run.report["options"] = options;
+  run.V = std::move(result.V);
+  return run;
+}
+
+MethodRun run_smooth(const Mesh& mesh, const SmoothFitOptions& options, const std::string* fitted_by,
+                     const EnhanceCallbacks& callbacks, const Warnings& warn) {
+  FitResult result = fit_to_smooth_surface(mesh.V, mesh.F, options);
+  const FitReport& r = result.report;
+  if (r.held_as_fitted)
+    warn(
+        fmt::format("its provenance comment '{}' records an earlier fit, which left the vertices off the surface "
+                    "the faces inscribe: smooth mode, which assumes them on it, held every vertex (provenance.h; "
+                    "--assume-on-surface fits anyway)",
+                    fitted_by ? *fitted_by : std::string()));
+  else if (r.held_as_decimated)
+    warn(
+        fmt::format("{:.1f}% of the faces are below quality 0.3, as on decimated meshes, whose vertices lie off "
+                    "the surface: smooth mode, which assumes them on it, held every vertex (fit.h; "
+                    "--assume-on-surface fits anyway)",
+                    100 * r.poor_face_fraction));
+  else
+    tell(callbacks.phase,
+         fmt::format("patches {:.3f} s; fitted in {} round{}: RMS distance to them {:.6g} -> {:.6g}; {} vertices "
+                     "limited by the guard",
+                     r.seconds_surface, r.rounds, r.rounds == 1 ? "" : "s", r.rms_distance.front(),
+                     r.rms_distance.back(), r.limited_vertices));
+  MethodRun run;
+  run.report = r;
+  run.report["fit"]["poor_face_fraction"] = r.poor_face_fraction;
+  run.report["fit"]["held_as_decimated"] = r.held_as_decimated;
+  run.report["fit"]["held_as_fitted"] = r.held_as_fitted;
+  run.report["fit"]["fitted_by"] = r.held_as_fitted && fitted_by ? nlohmann::json(*fitted_by) : nlohmann::json();
+  run.report["options"] = options.fit;
+  for (const char* unused : {"samples_per_vertex", "mesh_to_reference_weight", "seed"})
+    run.report["options"].erase(unused);
+  run.report["options"]["surface"] = options.surface;
+  run.report["options"]["max_poor_face_fraction"] = options.max_poor_face_fraction;
+  run.V = std::move(result.V);
+  return run;
+}
+
+MethodRun run_unsharp(const Mesh& mesh, const UnsharpOptions& options, const Warnings& warn) {
+  const auto start = Clock::now();
+  UnsharpResult result = unsharp_mask(mesh.V, mesh.F, options);
+  const double seconds = seconds_since(start);
+  warn_about_split(result.non_manifold.held_vertices, result.non_manifold.reversed_faces, result.non_manifold.cut_edges,
+                   warn);
+  MethodRun run;
+  run.report = result;
+  run.report["options"] = options;
+  run.report["seconds"] = {{"unsharp", seconds}};
+  run.V = std::move(result.V);
+  return run;
+}
+
+// Edge flips towards the reference, or towards the smooth estimate of the input. Reference mode
+// alternates them with a refit of the vertices on the new faces, for flip_cycles cycles. The
+// other modes flip once: the paper's flow keeps the vertices on the input surface, and smooth
+// mode's fit pairs each face with its own patch, which new faces do not have (a closest-point
+// refit to the estimate, tried instead, lost 1 point of mean distance on the 6k remeshes).
+nlohmann::json flip_and_refit(const Mesh& input, const ReferenceSurface* reference, const EnhanceOptions& o, Mesh& out,
+                              const EnhanceCallbacks& callbacks) {
+  const bool fit = reference != nullptr;
+  const auto start = Clock::now();
+  std::optional<DistanceQuery> estimate;
+  if (!fit) {
+    const Mesh target = smooth_surface_estimate(input.V, input.F, effective_smooth_options(o).surface);
+    estimate.emplace(target.V, target.F);
+  }
+  const DistanceQuery& to_target = fit ? reference->distance_query() : *estimate;
+  EdgeFlipOptions flips;
+  flips.min_quality = o.guard.min_quality;
+  // No face may end against the input face whose index it takes (faces_turned_over, the
+  // report's flip count).
+  Vertices slot_normals(input.F.rows(), 3);
+  for (Index f = 0; f < input.F.rows(); ++f) slot_normals.row(f) = face_normal(input.V, input.F, f).transpose();
+  const FitOptions refit = effective_fit_options(o);
+  nlohmann::json cycles = nlohmann::json::array();
+  Index total = 0;
+  for (int cycle = 0; cycle < o.flip_cycles; ++cycle) {
+    EdgeFlipResult flipped = flip_edges_toward(out.V, out.F, to_target, flips, &slot_normals);
+    const EdgeFlipReport& r = flipped.report;
+    nlohmann::json entry = {
+        {"flips", r.flips}, {"passes", r.passes}, {"rms_before", r.rms_before}, {"rms_after_flips", r.rms_after}};
+    total += r.flips;
+    if (r.flips > 0) {
+      out.F = std::move(flipped.F);
+      if (fit) {
+        out.V = fit_to_reference(out.V, out.F, *reference, refit).V;
+        entry["refitted"] = true;
+      }
+    }
+    tell(callbacks.phase,
+         fmt::format("edge flips, cycle {}: {} flips in {} passes, RMS distance to the {} {:.6g} -> {:.6g}", cycle + 1,
+                     r.flips, r.passes, fit ? "reference" : "smooth estimate", r.rms_before, r.rms_after));
+    cycles.push_back(std::move(entry));
+    if (r.flips == 0 || !fit) break;
+  }
+  return {{"cycles", cycles},
+          {"flips", total},
+          {"target", fit ? "reference" : "smooth estimate"},
+          {"seconds", seconds_since(start)}};
+}
+
+}  // namespace
+
+EnhanceMode enhance_mode(const EnhanceOptions& options, bool has_reference) {
+  return mode_of(options, has_reference, OptionNaming::Cpp);
+}
+
+const char* enhance_mode_name(EnhanceMode mode) {
+  switch (mode) {
+    case EnhanceMode::Flow:
+      return "flow";
+    case EnhanceMode::ReferenceFit:
+      return "reference";
+    case EnhanceMode::ReferenceFlow:
+      return "reference-flow";
+    case EnhanceMode::Smooth:
+      return "smooth";
+    case EnhanceMode::Unsharp:
+      return "unsharp";
+  }
+  return "?";
+}
+
+FlowOptions effective_flow_options(const EnhanceOptions& o) {
+  FlowOptions flow = o.flow;
+  flow.constraints = o.constraints;
+  flow.guard = o.guard;
+  flow.refuse_non_manifold = o.refuse_non_manifold;
+  flow.feature_angle = o.feature_angle;
+  return flow;
+}
+
+FitOptions effective_fit_options(const EnhanceOptions& o) {
+  FitOptions fit = o.fit;
+  fit.constraints = o.constraints;
+  fit.guard = o.guard;
+  if (o.max_rounds) fit.max_rounds = *o.max_rounds;
+  return fit;
+}
+
+SmoothFitOptions effective_smooth_options(const EnhanceOptions& o, bool already_fitted) {
+  SmoothFitOptions smooth = o.smooth;
+  smooth.surface.feature_angle = o.feature_angle;
+  smooth.fit.constraints = o.constraints;
+  smooth.fit.guard = o.guard;
+  if (o.max_rounds) smooth.fit.max_rounds = *o.max_rounds;
+  if (o.assume_on_surface) smooth.max_poor_face_fraction = 1.0;
+  smooth.already_fitted = already_fitted && !o.assume_on_surface;
+  return smooth;
+}
+
+UnsharpOptions effective_unsharp_options(const EnhanceOptions& o) {
+  UnsharpOptions unsharp = o.unsharp;
+  unsharp.constraints = o.constraints;
+  unsharp.refuse_non_manifold = o.refuse_non_manifold;
+  return unsharp;
+}
+
+void validate_enhance_options(const EnhanceOptions& options, bool has_reference, Index num_vertices,
+                              OptionNaming naming) {
+  const EnhanceMode mode = mode_of(options, has_reference, naming);
+  // Every option that does not apply to the mode keeps its default. (A default given
+  // explicitly is accepted: it changes nothing.)
+  static const EnhanceOptions defaults;
+  for (const EnhanceOptionSpec& spec : enhance_option_specs()) {
+    if (spec.modes & mode_bit(mode)) continue;
+    if (spec.get(options) != spec.get(defaults))
+      refuse(fmt::format("{} does not apply to {}", option_display_name(spec, naming), mode_display(mode, naming)));
+  }
+  if (!options.edge_flips && options.flip_cycles != defaults.flip_cycles)
+    refuse(name_of("flip_cycles", naming) + " applies to " + name_of("edge_flips", naming) + " only");
+  require_shared_untouched(options);
+  // The ranges, in the table's words first (the front ends' names), then the methods' own
+  // checks of what the table does not hold.
+  for (const EnhanceOptionSpec& spec : enhance_option_specs()) check_option_value(spec, spec.get(options), naming);
+  validate_vertex_constraints(options.constraints, num_vertices, "enhance");
+  switch (mode) {
+    case EnhanceMode::Flow:
+    case EnhanceMode::ReferenceFlow:
+      validate_flow_options(effective_flow_options(options), num_vertices);
+      break;
+    case EnhanceMode::ReferenceFit:
+      validate_fit_options(effective_fit_options(options), num_vertices, "fit to reference");
+      break;
+    case EnhanceMode::Smooth:
+      validate_fit_options(effective_smooth_options(options).fit, num_vertices, "fit to smooth surface");
+      break;
+    case EnhanceMode::Unsharp:
+      break;  // unsharp_mask checks its two numbers itself
+  }
+}
+
+EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const EnhanceOptions& options,
+                      const EnhanceCallbacks& callbacks) {
+  validate_enhance_options(options, reference != nullptr, mesh.num_vertices());
+  EnhanceResult result;
+  const EnhanceMode mode = enhance_mode(options, reference != nullptr);
+  result.mode = mode;
+  const Warnings warn{callbacks, result.warnings};
+  const FlowOptions flow = effective_flow_options(options);
+  switch (mode) {
+    case EnhanceMode::ReferenceFit:
+      tell(callbacks.phase,
+           fmt::format("fitting {} vertices to {} ({} faces)", mesh.num_vertices(),
+                       reference->name().empty() ? "the reference" : reference->name(), reference->faces().rows()));
+      break;
+    case EnhanceMode::Smooth:
+      tell(callbacks.phase,
+           fmt::format("fitting {} vertices to the smooth-surface estimate through them", mesh.num_vertices()));
+      break;
+    case EnhanceMode::ReferenceFlow:
+      tell(callbacks.phase, fmt::format("flowing {} vertices over {} (lambda {}, mu {})", mesh.num_vertices(),
+                                        reference->name().empty() ? "the reference" : reference->name(),
+                                        flow.weights.lambda, flow.weights.mu));
+      break;
+    case EnhanceMode::Unsharp:
+      tell(callbacks.phase,
+           fmt::format("unsharp mask on {} vertices (weight {}, {} smoothing iterations)", mesh.num_vertices(),
+                       options.unsharp.weight, options.unsharp.smoothing_iterations));
+      break;
+    case EnhanceMode::Flow:
+      tell(callbacks.phase, fmt::format("flowing {} vertices (lambda {}, mu {})", mesh.num_vertices(),
+                                        flow.weights.lambda, flow.weights.mu));
+      break;
+  }
+
+  // Smooth mode holds an input that an earlier fit already moved off the inscribed surface
+  // (provenance.h).
+  const std::string* fitted_by = find_fit_provenance(mesh.comments);
+  const SmoothFitOptions smooth = effective_smooth_options(options, fitted_by != nullptr);
+  MethodRun run;
+  switch (mode) {
+    case EnhanceMode::ReferenceFit:
+      run = run_fit(mesh, *reference, effective_fit_options(options), callbacks);
+      break;
+    case EnhanceMode::Smooth:
+      run = run_smooth(mesh, smooth, fitted_by, callbacks, warn);
+      break;
+    case EnhanceMode::Unsharp:
+      run = run_unsharp(mesh, effective_unsharp_options(options), warn);
+      break;
+    case EnhanceMode::ReferenceFlow:
+      run = run_flow(mesh, reference, flow, callbacks, warn);
+      break;
+    case EnhanceMode::Flow:
+      run = run_flow(mesh, nullptr, flow, callbacks, warn);
+      break;
+  }
+
+  // Same connectivity (unless edge flips) and colours; per-vertex properties of the input (say,
+  // curvature from an earlier run) no longer describe the moved vertices and are not carried.
+  Mesh& out = result.mesh;
+  out.V = std::move(run.V);
+  out.F = mesh.F;
+  out.colors = mesh.colors;
+  if (options.edge_flips)
+    run.report["edge_flips"] =
+        flip_and_refit(mesh, mode == EnhanceMode::ReferenceFit ? reference : nullptr, options, out, callbacks);
+
+  // The input's provenance and a line for this run, so a chain of runs stays visible and a
+  // later smooth-mode run can tell a fitted input (provenance.h).
+  ProvenanceRun provenance;
+  provenance.mode = mode;
+  if (reference) provenance.reference = reference->name();
+  provenance.edge_flips = options.edge_flips;
+  provenance.assume_on_surface = options.assume_on_surface;
+  if (mode == EnhanceMode::Smooth && run.report["fit"]["held_as_fitted"].get<bool>())
+    provenance.held = "already fitted";
+  if (mode == EnhanceMode::Smooth && run.report["fit"]["held_as_decimated"].get<bool>()) provenance.held = "decimated";
+  result.provenance = provenance_line(provenance);
+  out.comments = mesh.comments;
+  append_provenance(out.comments, result.provenance);
+  run.report["provenance"] = result.provenance;
+  run.report["method"] = enhance_mode_name(mode);
+  if (reference) run.report["reference_trees_built"] = reference->trees_built();
+  result.report = std::move(run.report);
+  return result;
+}
+
+}  // namespace vertexflow

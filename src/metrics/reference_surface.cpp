@@ -1,0 +1,72 @@
+#include "vertexflow/reference_surface.h"
+
+#include <atomic>
+#include <map>
+#include <mutex>
+#include <stdexcept>
+#include <tuple>
+
+namespace vertexflow {
+
+struct ReferenceSurface::Impl {
+  Vertices V;
+  Faces F;
+  std::string name;
+  std::once_flag tree_once;
+  std::unique_ptr<DistanceQuery> tree;
+  std::atomic<int> trees_built{0};
+  std::mutex samples_mutex;
+  // std::map: its nodes do not move, so a returned reference stays valid as others are added.
+  std::map<std::tuple<Index, std::uint64_t, bool, bool>, SurfaceSamples> samples;
+};
+
+ReferenceSurface::ReferenceSurface(Vertices V, Faces F, std::string name) : impl_(std::make_unique<Impl>()) {
+  if (V.rows() == 0 || F.rows() == 0) throw std::invalid_argument("reference surface: the reference is empty");
+  if (!V.allFinite())
+    throw std::invalid_argument("reference surface: a vertex of the reference has a non-finite coordinate");
+  impl_->V = std::move(V);
+  impl_->F = std::move(F);
+  impl_->name = std::move(name);
+}
+
+ReferenceSurface::~ReferenceSurface() = default;
+ReferenceSurface::ReferenceSurface(ReferenceSurface&&) noexcept = default;
+ReferenceSurface& ReferenceSurface::operator=(ReferenceSurface&&) noexcept = default;
+
+const Vertices& ReferenceSurface::vertices() const {
+  return impl_->V;
+}
+const Faces& ReferenceSurface::faces() const {
+  return impl_->F;
+}
+const std::string& ReferenceSurface::name() const {
+  return impl_->name;
+}
+
+const DistanceQuery& ReferenceSurface::distance_query() const {
+  std::call_once(impl_->tree_once, [this] {
+    impl_->tree = std::make_unique<DistanceQuery>(impl_->V, impl_->F);
+    ++impl_->trees_built;
+  });
+  return *impl_->tree;
+}
+
+const SurfaceSamples& ReferenceSurface::samples(const SamplingOptions& options) const {
+  const auto key = std::make_tuple(options.samples, options.seed, options.vertices, options.edge_midpoints);
+  {
+    const std::lock_guard lock(impl_->samples_mutex);
+    const auto it = impl_->samples.find(key);
+    if (it != impl_->samples.end()) return it->second;
+  }
+  // Drawn outside the lock (it takes a while on a dense S); a second caller with the same
+  // options meanwhile draws the same samples, and the first stored is kept.
+  SurfaceSamples drawn = sample_surface(impl_->V, impl_->F, options);
+  const std::lock_guard lock(impl_->samples_mutex);
+  return impl_->samples.try_emplace(key, std::move(drawn)).first->second;
+}
+
+int ReferenceSurface::trees_built() const {
+  return impl_->trees_built.load();
+}
+
+}  // namespace vertexflow

@@ -1,0 +1,164 @@
+// The batch engine (batch.h) and `vertexflow batch`: every mode, references from a manifest or a
+// directory, outputs bit for bit those of `vertexflow enhance`, summaries with each file's mode
+// and distances, and a directory's own summaries never taken for inputs.
+#include "shapes.h"
+#include "test_support.h"
+
+#include "vertexflow/batch.h"
+#include "vertexflow/io.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+#include <string>
+
+namespace vertexflow {
+namespace {
+
+std::string bytes(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+void write_text(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream(path) << text;
+}
+
+// (coarse, dense) pairs of analytic surfaces: an icosphere and a torus at two resolutions.
+struct Pairs {
+  test::ScratchDir dir{"batch-pairs"};
+  std::filesystem::path coarse = dir.file("coarse"), dense = dir.file("dense");
+  Pairs() {
+    std::filesystem::create_directories(coarse);
+    std::filesystem::create_directories(dense);
+    write_mesh(coarse / "sphere.off", test::icosphere(1.0, 2));
+    write_mesh(dense / "sphere.ply", test::icosphere(1.0, 5));
+    write_mesh(coarse / "torus.obj", test::torus(1.0, 0.3, 24, 10));
+    write_mesh(dense / "torus.off", test::torus(1.0, 0.3, 160, 64));
+  }
+};
+
+// Reference mode over a manifest: each output is what `vertexflow enhance --reference` writes,
+// the summary names the mode and has both distances (the result's below the input's), and a
+// row whose reference is missing fails alone.
+TEST(Batch, ReferenceModeOverAManifestWritesWhatEnhanceWrites) {
+  const Pairs p;
+  const auto manifest = p.dir.file("pairs.csv");
+  write_text(manifest,
+             "input,reference,output\n"
+             "coarse/sphere.off,dense/sphere.ply,\n"
+             "\"coarse/torus.obj\",dense/torus.off,out/torus-fitted.obj\n"
+             "coarse/sphere.off,dense/missing.off,out/missing.off\n");
+  const auto out = p.dir.file("out");
+  const auto r =
+      test::run_cli("--quiet batch --manifest " + test::quoted(manifest) + " " + test::quoted(out) + " --max-rounds 3");
+  EXPECT_EQ(r.exit_code, 1) << r.err;  // one file failed
+  for (const auto& [input, reference, output] :
+       {std::tuple{p.coarse / "sphere.off", p.dense / "sphere.ply", out / "sphere.off"},
+        std::tuple{p.coarse / "torus.obj", p.dense / "torus.off", out / "torus-fitted.obj"}}) {
+    const auto expected = p.dir.file("expected" + output.extension().string());
+    const auto e = test::run_cli("--quiet enhance " + test::quoted(input) + " " + test::quoted(expected) +
+                                 " --reference " + test::quoted(reference) + " --max-rounds 3");
+    ASSERT_EQ(e.exit_code, 0) << e.err;
+    ASSERT_TRUE(std::filesystem::exists(output)) << output;
+    EXPECT_EQ(bytes(output), bytes(expected)) << output;
+    EXPECT_NE(read_mesh(output).V, read_mesh(input).V) << output;
+  }
+  const nlohmann::json summary = nlohmann::json::parse(test::read_text(out / "batch_summary.json"));
+  EXPECT_EQ(summary["mode"], "reference");
+  EXPECT_EQ(summary["options"]["max_rounds"], 3);
+  ASSERT_EQ(summary["files"].size(), 3u);
+  for (int i = 0; i < 2; ++i) {
+    const auto& row = summary["files"][i];
+    EXPECT_EQ(row["status"], "done") << row.dump();
+    EXPECT_EQ(row["mode"], "reference");
+    const auto& d = row["distance_to_reference"]["mean"];
+    EXPECT_LT(d["result"].get<double>(), d["input"].get<double>()) << row.dump();
+  }
+  EXPECT_EQ(summary["files"][2]["status"], "failed");
+  EXPECT_NE(summary["files"][2]["error"].get<std::string>().find("missing.off"), std::string::npos);
+  const std::string csv = test::read_text(out / "batch_summary.csv");
+  EXPECT_NE(csv.find("distance_mean_input,distance_mean_result"), std::string::npos);
+}
+
+// --reference-dir matches references by stem; a directory input skips files that are not meshes
+// (here, an earlier batch's summaries written into it).
+TEST(Batch, ReferenceDirectoryMatchesByStemAndSummariesAreNotInputs) {
+  const Pairs p;
+  write_text(p.coarse / "batch_summary.csv", "input,output\n");
+  write_text(p.coarse / "batch_summary.json", "{}\n");
+  write_text(p.coarse / "notes.txt", "not a mesh\n");
+  const auto out = p.dir.file("out");
+  const auto r = test::run_cli("--quiet batch " + test::quoted(p.coarse) + " " + test::quoted(out) +
+                               " --reference-dir " + test::quoted(p.dense) + " --reference-method flow");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const nlohmann::json summary = nlohmann::json::parse(test::read_text(out / "batch_summary.json"));
+  ASSERT_EQ(summary["files"].size(), 2u);
+  for (const auto& row : summary["files"]) {
+    EXPECT_EQ(row["status"], "done") << row.dump();
+    EXPECT_EQ(row["mode"], "reference-flow");
+    EXPECT_FALSE(row["reference"].is_null());
+  }
+  const auto expected = p.dir.file("expected.off");
+  ASSERT_EQ(test::run_cli("--quiet enhance " + test::quoted(p.coarse / "sphere.off") + " " + test::quoted(expected) +
+                          " --reference " + test::quoted(p.dense / "sphere.ply") + " --reference-method flow")
+                .exit_code,
+            0);
+  EXPECT_EQ(bytes(out / "sphere.off"), bytes(expected));
+}
+
+// Every mode of `enhance` runs in batch, with the same bytes; options that do not apply are
+// refused before any file is read, in the CLI's words.
+TEST(Batch, EveryModeWritesWhatEnhanceWrites) {
+  test::ScratchDir dir("batch-modes");
+  const auto in = dir.file("in");
+  std::filesystem::create_directories(in);
+  std::filesystem::copy_file(test::data_path("sphere_low.off"), in / "sphere_low.off");
+  int run = 0;
+  for (const std::string options :
+       {"", "--surface smooth", "--method unsharp", "--density-passes 3", "--edge-flips", "--lambda 2 --mu 1"}) {
+    const auto out = dir.file("out" + std::to_string(run++));
+    const auto r = test::run_cli("--quiet batch " + test::quoted(in) + " " + test::quoted(out) + " " + options);
+    ASSERT_EQ(r.exit_code, 0) << options << ": " << r.err;
+    const auto expected = dir.file("expected.off");
+    std::filesystem::remove(expected);
+    ASSERT_EQ(test::run_cli("--quiet enhance " + test::quoted(in / "sphere_low.off") + " " + test::quoted(expected) +
+                            " " + options)
+                  .exit_code,
+              0);
+    EXPECT_EQ(bytes(out / "sphere_low.off"), bytes(expected)) << options;
+  }
+  const auto refused =
+      test::run_cli("batch " + test::quoted(in) + " " + test::quoted(dir.file("x")) + " --surface smooth --lambda 2");
+  EXPECT_EQ(refused.exit_code, 1);
+  EXPECT_NE(refused.err.find("--lambda does not apply to --surface smooth"), std::string::npos) << refused.err;
+  EXPECT_FALSE(std::filesystem::exists(dir.file("x")));
+}
+
+TEST(Batch, ManifestProblemsNameTheFileAndLine) {
+  test::ScratchDir dir("batch-manifest-bad");
+  const auto csv = dir.file("m.csv");
+  write_text(csv, "reference,output\na.off,b.off\n");
+  try {
+    (void)read_batch_manifest(csv);
+    ADD_FAILURE() << "no input column accepted";
+  } catch (const IoError& e) {
+    EXPECT_NE(std::string(e.what()).find("m.csv: line 1"), std::string::npos) << e.what();
+  }
+  write_text(csv, "input,reference\n,a.off\n");
+  EXPECT_THROW((void)read_batch_manifest(csv), IoError);
+  const auto json = dir.file("m.json");
+  write_text(json, R"([{"input": "a/x.off", "reference": "r.ply"}, {"input": "/abs/y.obj"}])");
+  const std::vector<BatchItem> items = read_batch_manifest(json);
+  ASSERT_EQ(items.size(), 2u);
+  EXPECT_EQ(items[0].input, dir.file("a/x.off"));  // relative to the manifest's directory
+  EXPECT_EQ(items[0].reference, dir.file("r.ply"));
+  EXPECT_EQ(items[1].input, std::filesystem::path("/abs/y.obj"));
+  EXPECT_TRUE(items[1].reference.empty());
+  write_text(json, R"({"input": "a.off"})");
+  EXPECT_THROW((void)read_batch_manifest(json), IoError);
+}
+
+}  // namespace
+}  // namespace vertexflow
