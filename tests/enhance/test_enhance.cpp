@@ -46,6 +46,11 @@ TEST(Enhance, EachModeIsItsMethodWithTheSharedOptions) {
   const Mesh bunny = read_mesh(test::data_path("bunny_uniform.off"));
   const Mesh dense = read_mesh(test::data_path("bunny.off"));
   const ReferenceSurface reference(dense.V, dense.F, "bunny.off");
+  // What the engine must run the flow with: its own lambda, the shared guard and pins.
+  FlowOptions flow;
+  flow.weights.lambda = 2;
+  flow.guard.min_quality = 0.25;
+  flow.constraints.pinned = {0, 7};
   for (const EnhanceMode mode : kModes) {
     EnhanceOptions o = with_mode(mode);
     o.guard.min_quality = 0.25;     // shared: the flow's, the fit's and smooth mode's guard
@@ -55,22 +60,12 @@ TEST(Enhance, EachModeIsItsMethodWithTheSharedOptions) {
     const EnhanceResult r = enhance(bunny, needs_reference(mode) ? &reference : nullptr, o);
     Vertices expected;
     switch (mode) {
-      case EnhanceMode::Flow: {
-        FlowOptions f;
-        f.weights.lambda = 2;
-        f.guard.min_quality = 0.25;
-        f.constraints.pinned = {0, 7};
-        expected = vertex_flow(bunny.V, bunny.F, f).V;
+      case EnhanceMode::Flow:
+        expected = vertex_flow(bunny.V, bunny.F, flow).V;
         break;
-      }
-      case EnhanceMode::ReferenceFlow: {
-        FlowOptions f;
-        f.weights.lambda = 2;
-        f.guard.min_quality = 0.25;
-        f.constraints.pinned = {0, 7};
-        expected = vertex_flow_on_reference(bunny.V, bunny.F, dense.V, dense.F, f).V;
+      case EnhanceMode::ReferenceFlow:
+        expected = vertex_flow_on_reference(bunny.V, bunny.F, dense.V, dense.F, flow).V;
         break;
-      }
       case EnhanceMode::ReferenceFit: {
         FitOptions f;
         f.guard.min_quality = 0.25;
