@@ -43,7 +43,8 @@ struct EnhanceOptionSpec {
   /// Bool options whose CLI flag sets the opposite (--no-projection sets project_to_input false).
   bool flag_negates = false;
   OptionKind kind = OptionKind::Double;
-  std::vector<std::string_view> choices;  ///< Choice: the names, in the order of the enum
+  std::vector<std::string_view> choices;  ///< Choice: the names, in the help's order
+  std::vector<long long> choice_values;   ///< Choice: the enumerator each name stands for
   /// Int, Double, OptionalInt: the allowed range; *_open excludes the bound itself.
   double min = -1e308, max = 1e308;
   bool min_open = false, max_open = false;
@@ -59,6 +60,10 @@ const std::vector<EnhanceOptionSpec>& enhance_option_specs();
 
 /// The spec of the option with Python keyword `name`, or nullptr.
 const EnhanceOptionSpec* find_enhance_option(std::string_view name);
+
+/// The name of the Choice option `option`'s enumerator `value` (its integer value), as the CLI,
+/// Python and the reports spell it ("input-normal", "max1999", ...); "?" for none.
+std::string_view choice_name(std::string_view option, long long value);
 
 /// The option's name as `naming` says (enhance.h, OptionNaming).
 std::string option_display_name(const EnhanceOptionSpec& spec, OptionNaming naming);

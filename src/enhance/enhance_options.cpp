@@ -83,7 +83,10 @@ EnhanceOptionSpec ranged(EnhanceOptionSpec s, double min, double max, bool min_o
 // enumerator (the table's order is the help's, not necessarily the enum's).
 template <typename Enum>
 EnhanceOptionSpec choice(EnhanceOptionSpec s, std::vector<std::pair<std::string_view, Enum>> values) {
-  for (const auto& [name, value] : values) s.choices.push_back(name);
+  for (const auto& [name, value] : values) {
+    s.choices.push_back(name);
+    s.choice_values.push_back(static_cast<long long>(value));
+  }
   auto get_value = s.get;
   auto set_value = s.set;
   s.get = [get_value, values](const EnhanceOptions& o) -> OptionValue {
@@ -322,6 +325,13 @@ const EnhanceOptionSpec* find_enhance_option(std::string_view name) {
   for (const auto& spec : enhance_option_specs())
     if (spec.name == name) return &spec;
   return nullptr;
+}
+
+std::string_view choice_name(std::string_view option, long long value) {
+  if (const EnhanceOptionSpec* spec = find_enhance_option(option))
+    for (std::size_t i = 0; i < spec->choice_values.size(); ++i)
+      if (spec->choice_values[i] == value) return spec->choices[i];
+  return "?";
 }
 
 std::string option_display_name(const EnhanceOptionSpec& spec, OptionNaming naming) {

@@ -1,11 +1,14 @@
 #include "vertexflow/report_json.h"
 
+#include "vertexflow/enhance_options.h"
+
 #include <nlohmann/json.hpp>
 
 namespace vertexflow {
 
+// The enumerations' names are the option table's (enhance_options.h), written once there.
 void to_json(nlohmann::json& j, FairnessTarget target) {
-  j = target == FairnessTarget::Zero ? "zero" : "input-normal";
+  j = choice_name("fairness_target", static_cast<long long>(target));
 }
 
 void to_json(nlohmann::json& j, LinearSolver solver) {
@@ -27,18 +30,7 @@ void to_json(nlohmann::json& j, LinearSolver solver) {
 }
 
 void to_json(nlohmann::json& j, NormalWeighting weighting) {
-  switch (weighting) {
-    case NormalWeighting::Max1999:
-      j = "max1999";
-      return;
-    case NormalWeighting::Area:
-      j = "area";
-      return;
-    case NormalWeighting::Angle:
-      j = "angle";
-      return;
-  }
-  j = "?";
+  j = choice_name("normal_weighting", static_cast<long long>(weighting));
 }
 
 void to_json(nlohmann::json& j, const EnergyWeights& weights) {
