@@ -179,6 +179,8 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
       reference.emplace(std::move(dense.V), std::move(dense.F), o->reference_file);
     }
     const ReferenceSurface* reference_pointer = reference ? &*reference : nullptr;
+    // Trees over the reference's faces that the run and its report build (reference_surface.h).
+    const std::uint64_t trees_before = reference ? distance_trees_built(reference->faces().rows()) : 0;
     EnhanceResult result;
     try {
       result = enhance(mesh, reference_pointer, options, callbacks);
@@ -208,7 +210,7 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     report["output"] = o->output;
     if (reference) {
       report["reference"] = o->reference_file;
-      report["reference_trees_built"] = reference->trees_built();
+      report["reference_trees_built"] = distance_trees_built(reference->faces().rows()) - trees_before;
     }
     if (!o->report_file.empty()) {
       write_text_file(o->report_file, report.dump(2) + "\n");

@@ -61,7 +61,8 @@ struct BatchFileOptions {
   int threads = 0;
 };
 
-/// Reads `input` (and `reference`, when not empty), enhances it, writes `output` atomically and
+/// Reads `input` (and `reference`, when not empty), enhances it, writes `output` atomically (its
+/// directory created if need be) and
 /// measures the result. Never throws for a problem of the file (unreadable, not a mesh, a mesh
 /// the method refuses, a missing reference, an output that cannot be written): the row says
 /// "failed" and gives the error. An existing output is skipped unless options.force. An output
@@ -105,6 +106,8 @@ struct BatchOptions {
   std::function<void(const BatchProgress&)> progress;
   /// Write batch_summary.csv and batch_summary.json into output_dir.
   bool write_summary = true;
+  /// How the options' errors name an option (the front end's words, enhance.h).
+  OptionNaming naming = OptionNaming::Cpp;
 };
 
 struct BatchSummary {
@@ -123,6 +126,12 @@ std::vector<std::filesystem::path> batch_inputs(const std::vector<std::string>& 
 /// Relative paths are taken relative to the manifest's directory. Throws IoError naming the
 /// file and the line (or row) of a problem.
 std::vector<BatchItem> read_batch_manifest(const std::filesystem::path& manifest);
+
+/// The files of a batch as run_batch takes them: `items`, or the files of `inputs`; each output
+/// resolved (empty: output_dir and the input's file name) and, with a reference_dir, each
+/// reference found by stem (empty where none is). Throws IoError as batch_inputs, and for a
+/// reference_dir that is not a directory.
+std::vector<BatchItem> batch_items(const BatchOptions& options);
 
 /// Runs the batch. Throws IoError only for problems of the batch as a whole (no inputs, an
 /// output directory that cannot be created, an unreadable manifest) and std::invalid_argument

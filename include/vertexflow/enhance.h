@@ -138,8 +138,10 @@ struct EnhanceResult {
   EnhanceMode mode = EnhanceMode::Flow;
   /// The report's method sections: "method", "options", what the method reported (solver,
   /// guard, fit, non_manifold, ...), "seconds" of its phases, "edge_flips", "provenance", and
-  /// "reference_trees_built" in the reference modes. The front ends add the files, the read and
-  /// write times and the metrics (enhance_metrics).
+  /// "reference_trees_built" in the reference modes (the trees over the reference's faces this
+  /// run built: 1 for the fit with its flips and refits; the flow on S builds its own, in its
+  /// normalised units, and a report's distances then build the ReferenceSurface's). The front ends add the files, the
+  /// read and write times and the metrics (enhance_metrics).
   nlohmann::json report;
   /// This run's provenance line (also the last of mesh.comments).
   std::string provenance;

@@ -182,6 +182,11 @@ BatchRow enhance_file(const std::filesystem::path& input, const std::filesystem:
   std::error_code ec;
   try {
     check_output_path(input, output, /*force=*/false, /*mesh_output=*/true);
+    // A manifest may name outputs in directories of their own.
+    if (output.has_parent_path() && !std::filesystem::exists(output.parent_path(), ec)) {
+      std::filesystem::create_directories(output.parent_path(), ec);
+      if (ec) throw IoError(output.string() + ": cannot create its directory: " + ec.message());
+    }
     if (!reference.empty()) {
       check_output_path(reference, output, /*force=*/false, /*mesh_output=*/true);
       if (!std::filesystem::exists(reference, ec))
@@ -347,6 +352,8 @@ std::filesystem::path reference_in(const std::filesystem::path& directory, const
   return matches.empty() ? std::filesystem::path() : matches.front();
 }
 
+}  // namespace
+
 std::vector<BatchItem> batch_items(const BatchOptions& options) {
   std::vector<BatchItem> items = options.items;
   if (items.empty())
@@ -362,8 +369,6 @@ std::vector<BatchItem> batch_items(const BatchOptions& options) {
   return items;
 }
 
-}  // namespace
-
 BatchSummary run_batch(const BatchOptions& options) {
   if (options.jobs < 1) throw std::invalid_argument("jobs must be at least 1");
   if (options.file.threads < 0) throw std::invalid_argument("threads must be at least 0 (0: all cores)");
@@ -376,7 +381,7 @@ BatchSummary run_batch(const BatchOptions& options) {
   const bool reference_mode =
       !options.reference_dir.empty() ||
       std::any_of(items.begin(), items.end(), [](const BatchItem& i) { return !i.reference.empty(); });
-  validate_enhance_options(options.file.enhance, reference_mode);
+  validate_enhance_options(options.file.enhance, reference_mode, -1, options.naming);
   std::error_code ec;
   std::filesystem::create_directories(options.output_dir, ec);
   if (ec || !std::filesystem::is_directory(options.output_dir))

@@ -361,6 +361,9 @@ void validate_enhance_options(const EnhanceOptions& options, bool has_reference,
 EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const EnhanceOptions& options,
                       const EnhanceCallbacks& callbacks) {
   validate_enhance_options(options, reference != nullptr, mesh.num_vertices());
+  // Trees over the reference's faces this run builds (its own, or any step's copy): one is the
+  // promise of reference_surface.h, the flow on S's own tree a second (flow.h).
+  const std::uint64_t trees_before = reference ? distance_trees_built(reference->faces().rows()) : 0;
   EnhanceResult result;
   const EnhanceMode mode = enhance_mode(options, reference != nullptr);
   result.mode = mode;
@@ -440,7 +443,7 @@ EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const
   append_provenance(out.comments, result.provenance);
   run.report["provenance"] = result.provenance;
   run.report["method"] = enhance_mode_name(mode);
-  if (reference) run.report["reference_trees_built"] = reference->trees_built();
+  if (reference) run.report["reference_trees_built"] = distance_trees_built(reference->faces().rows()) - trees_before;
   result.report = std::move(run.report);
   return result;
 }

@@ -153,7 +153,7 @@ std::vector<EnhanceOptionSpec> make_specs() {
                      0, kInf, true, true));
   t.push_back(ranged(member_spec(
                          "sliver", "flow.weights.sliver", "--sliver-stiffness", K::Double, kFlowModes,
-                         "Weight of the solve's term that keeps corners of faces below --min-quality from "
+                         "Weight of the solve's term that keeps corners of faces below the min quality from "
                          "their opposite edges (0: the guard alone)",
                          [](auto& o) -> auto& { return o.flow.weights.sliver; }),
                      0, kInf, false, true));
@@ -254,7 +254,7 @@ std::vector<EnhanceOptionSpec> make_specs() {
                      0, 1));
   t.push_back(ranged(member_spec(
                          "sliver_floor", "guard.sliver_floor", "--sliver-floor", K::Double, kGuarded,
-                         "Guard: a face starting below --min-quality may not fall below this fraction of its "
+                         "Guard: a face starting below the min quality may not fall below this fraction of its "
                          "input ratio",
                          [](auto& o) -> auto& { return o.guard.sliver_floor; }),
                      0, 1));

@@ -242,6 +242,8 @@ TEST(CliEnhanceOptions, EdgeFlipsFlipOntoTheRidgeOfTheReference) {
   EXPECT_EQ(flipped["flipped_faces"], 0);
   EXPECT_GE(flipped["edge_flips"]["flips"].get<Index>(), 6);  // measured 8, the ridge squares
   EXPECT_EQ(flipped["edge_flips"]["target"], "reference");
+  // One tree of the reference for the fit, the flips, each refit and the report (issue 27).
+  EXPECT_EQ(flipped["reference_trees_built"], 1);
   const double alone = fitted["distance_to_reference"]["result"]["mean"].get<double>();
   const double with_flips = flipped["distance_to_reference"]["result"]["mean"].get<double>();
   std::cout << "[measured] roof: mean distance fitted " << alone << ", fitted and flipped " << with_flips << "\n";
