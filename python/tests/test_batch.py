@@ -1,15 +1,17 @@
-"""`vertexflow batch` and vertexflow.batch(): 20 data meshes, a corrupt file and a non-mesh file;
-failures reported and skipped, outputs as `vertexflow enhance` writes them, resumable."""
+"""`vertexflow batch` and vertexflow.batch(): 20 data meshes, a corrupt file and a non-mesh file (not
+listed: a directory gives its mesh files); failures reported and skipped, outputs as `vertexflow enhance` writes them, resumable. Reference
+mode over a manifest of (coarse, dense) pairs: the bytes of `vertexflow enhance --reference`."""
 
 import csv
 import json
+import os
 import shutil
 
 import numpy as np
 import pytest
 
 import vertexflow
-from conftest import DATA, run_cli
+from conftest import DATA, cli_reference_outputs, run_cli, sha256, write_manifest
 
 
 @pytest.fixture(scope="module")
@@ -39,14 +41,14 @@ def read_summary(out):
 def test_batch_completes_and_reports_both_failures(cli_run):
     out, first = cli_run
     assert first.returncode == 1  # some files failed, after all of them were tried
-    assert "2 of 22 files failed" in first.stderr
+    assert "1 of 21 files failed" in first.stderr
     rows, summary = read_summary(out)
-    assert len(rows) == 22 and len(summary["files"]) == 22
+    assert len(rows) == 21 and len(summary["files"]) == 21
     status = {r["input"].rsplit("/", 1)[1]: r for r in rows}
     assert status["corrupt.off"]["status"] == "failed" and "corrupt.off" in status["corrupt.off"]["error"]
-    assert status["notes.txt"]["status"] == "failed" and "notes.txt" in status["notes.txt"]["error"]
+    assert "notes.txt" not in status  # not a mesh file name
     done = [r for r in rows if r["status"] == "done"]
-    assert len(done) == 20 and summary["done"] == 20 and summary["failed"] == 2
+    assert len(done) == 20 and summary["done"] == 20 and summary["failed"] == 1
     for r in done:
         assert r["error"] == ""
         assert int(r["flipped_faces"]) == 0
@@ -74,7 +76,7 @@ def test_second_run_skips_everything_done(cli_run, messy):
     first_rows, _ = read_summary(out)
     second = run_cli("batch", messy, out, "--jobs", "2", check=False)
     rows, summary = read_summary(out)
-    assert summary["skipped"] == 20 and summary["done"] == 0 and summary["failed"] == 2
+    assert summary["skipped"] == 20 and summary["done"] == 0 and summary["failed"] == 1
     # The skipped files keep the first run's measurements: the table still describes every output.
     for old, new in zip(first_rows, rows):
         assert old["input"] == new["input"]
@@ -91,8 +93,8 @@ def test_python_batch_gives_the_same_bytes(cli_run, messy, tmp_path):
     out, _ = cli_run
     calls = []
     result = vertexflow.batch(messy, tmp_path / "py", jobs=1, threads=1, progress=calls.append)
-    assert result["done"] == 20 and result["failed"] == 2 and len(result["files"]) == 22
-    assert len(calls) == 22 and calls[-1]["finished"] == 22 and calls[-1]["total"] == 22
+    assert result["done"] == 20 and result["failed"] == 1 and len(result["files"]) == 21
+    assert len(calls) == 21 and calls[-1]["finished"] == 21 and calls[-1]["total"] == 21
     for row in result["files"]:
         if row["status"] == "done":
             name = row["input"].rsplit("/", 1)[1]
@@ -106,6 +108,8 @@ def test_enhance_file_reports_failures_without_raising(messy, tmp_path):
     row = vertexflow.enhance_file(messy / "corrupt.off", tmp_path / "corrupt.off")
     assert row["status"] == "failed" and "corrupt.off" in row["error"]
     assert not (tmp_path / "corrupt.off").exists()
+    row = vertexflow.enhance_file(messy / "notes.txt", tmp_path / "notes.txt")
+    assert row["status"] == "failed" and "notes.txt" in row["error"]
     row = vertexflow.enhance_file(messy / "spot.obj", messy / "spot.obj")
     assert row["status"] == "failed"  # never overwrites its input
     row = vertexflow.enhance_file(DATA / "spot.obj", tmp_path / "spot.obj", lam=0.5)
@@ -114,3 +118,51 @@ def test_enhance_file_reports_failures_without_raising(messy, tmp_path):
     V_out, _ = vertexflow.enhance(V, F, lam=0.5)
     V_file, _ = vertexflow.read_mesh(tmp_path / "spot.obj")
     assert np.array_equal(V_file, V_out)  # OBJ writes 17 significant digits: exact
+
+
+# --- reference mode over (coarse, dense) pairs: the level-of-detail pipeline -----------------------
+
+
+@pytest.fixture(scope="module")
+def lod_cli(lod_pairs, tmp_path_factory):
+    """`vertexflow enhance COARSE OUT --reference DENSE` per pair: {file name: sha256}."""
+    return cli_reference_outputs(lod_pairs, tmp_path_factory.mktemp("lod_cli"))
+
+
+def test_batch_over_a_manifest_of_pairs_writes_what_enhance_reference_writes(lod_pairs, lod_cli, tmp_path):
+    assert len(lod_pairs) >= 4
+    coarse_dir = lod_pairs[0][0].parent
+    # Inputs relative to the manifest's directory, references absolute; one row names its output.
+    rows = [{"input": os.path.relpath(c, tmp_path), "reference": d} for c, d in lod_pairs]
+    rows[0]["output"] = "named/" + lod_pairs[0][0].name
+    # A row without a reference and one whose reference is missing: their own errors, not the batch's.
+    rows += [{"input": DATA / "spot.obj"}, {"input": DATA / "torus.obj", "reference": tmp_path / "missing.obj"}]
+    manifest_csv = write_manifest(tmp_path / "pairs.csv", rows)
+    read = vertexflow.read_batch_manifest(manifest_csv)
+    assert [os.path.realpath(r["input"]) for r in read[: len(lod_pairs)]] == [os.path.realpath(c) for c, _ in lod_pairs]
+    assert read[0]["output"] == str(tmp_path / "named" / lod_pairs[0][0].name) and read[1]["output"] is None
+
+    (tmp_path / "named").mkdir()  # the batch creates output_dir, not a row's own directory
+    out = tmp_path / "py"
+    summary = vertexflow.batch(output_dir=out, manifest=manifest_csv, jobs=2, threads=1)
+    assert summary["done"] == len(lod_pairs) and summary["failed"] == 2
+    files = summary["files"]
+    assert "has no reference" in files[-2]["error"] and "missing.obj" in files[-1]["error"]
+    named = tmp_path / "named" / lod_pairs[0][0].name
+    assert files[0]["output"] == str(named)
+    for (coarse, dense), row in zip(lod_pairs, files):
+        output = named if row is files[0] else out / coarse.name
+        assert sha256(output) == lod_cli[coarse.name], coarse.name
+        # The summary records the mode and the distances to the reference; the fit lowers the mean.
+        assert row["mode"] == "reference" and row["reference"] == str(dense)
+        distance = row["distance_to_reference"]["mean"]
+        assert distance["result"] < distance["input"], coarse.name
+
+    # The CLI's batch over the same rows as a JSON manifest, and reference_dir (matched by stem).
+    manifest_json = write_manifest(tmp_path / "pairs.json", [{"input": c, "reference": d} for c, d in lod_pairs])
+    run_cli("-q", "batch", "--manifest", manifest_json, tmp_path / "cli", "--jobs", "2", "--threads", "1")
+    by_stem = vertexflow.batch(coarse_dir, tmp_path / "by_stem", reference_dir=DATA, jobs=2, threads=1)
+    assert by_stem["done"] == len(lod_pairs)
+    for coarse, _ in lod_pairs:
+        assert sha256(tmp_path / "cli" / coarse.name) == lod_cli[coarse.name], coarse.name
+        assert sha256(tmp_path / "by_stem" / coarse.name) == lod_cli[coarse.name], coarse.name
