@@ -111,8 +111,17 @@ struct ReadReport {
   std::int64_t repeated_index_faces_removed = 0;
   std::int64_t duplicate_faces_removed = 0;
   std::int64_t zero_area_faces_removed = 0;
+  /// Triangles read from PLY `tristrips` elements (strips with -1 restarts; the strips'
+  /// degenerate stitching triangles are not faces and are skipped).
+  std::int64_t strip_triangles = 0;
+  /// What the file holds that the mesh does not keep, one entry each with its count, e.g.
+  /// "vt (3225 texture coordinates)", "PLY face property 'material'", in the order first met.
+  /// Until attributes are carried (docs/attributes.md, issue 28) they are named here, so that
+  /// no command drops them without a warning.
+  std::vector<std::string> not_kept;
 
-  /// One human-readable line per non-zero count, e.g. "3 duplicate faces removed".
+  /// One human-readable line per non-zero count, e.g. "3 duplicate faces removed", and one line
+  /// naming what was not kept.
   [[nodiscard]] std::vector<std::string> warnings() const;
 };
 

@@ -424,6 +424,13 @@ EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const
   out.V = std::move(run.V);
   out.F = mesh.F;
   out.colors = mesh.colors;
+  if (!mesh.vertex_properties.empty()) {
+    std::string names;
+    for (const VertexProperty& p : mesh.vertex_properties) names += (names.empty() ? "" : ", ") + p.name;
+    warn("vertex properties not carried: " + names +
+         " (they describe the input's vertices; re-sampling them where the vertices move is planned, "
+         "docs/attributes.md)");
+  }
   if (options.edge_flips)
     run.report["edge_flips"] =
         flip_and_refit(mesh, mode == EnhanceMode::ReferenceFit ? reference : nullptr, options, out, callbacks);

@@ -17,27 +17,34 @@ namespace vertexflow::io_detail {
 
 /// What a parser produces: vertices and polygons exactly as the file lists them.
 struct PolygonSoup {
-  std::vector<double> xyz;                    // 3 per vertex
-  std::vector<Index> corners;                 // polygon corners, concatenated
-  std::vector<std::int64_t> offsets{0};       // polygon p is corners[offsets[p], offsets[p+1])
-  std::vector<std::uint8_t> rgb;              // empty or 3 per vertex
-  std::vector<VertexProperty> properties;     // per-vertex scalars other than x, y, z, colours
-  std::vector<std::string> comments;          // Mesh::comments, bounded by add_comment
-  bool weld_vertices = false;                 // STL: facets carry their own vertex copies
-  int index_base = 0;                         // how the file numbers vertices (OBJ: 1), for messages
+  std::vector<double> xyz;                 // 3 per vertex
+  std::vector<Index> corners;              // polygon corners, concatenated
+  std::vector<std::int64_t> offsets{0};    // polygon p is corners[offsets[p], offsets[p+1])
+  std::vector<std::uint8_t> rgb;           // empty or 3 per vertex
+  std::vector<VertexProperty> properties;  // per-vertex scalars other than x, y, z, colours
+  std::vector<std::string> comments;       // Mesh::comments, bounded by add_comment
+  // What the file holds that the mesh does not keep, with counts (ReadReport::not_kept).
+  std::vector<std::pair<std::string, std::int64_t>> not_kept;
+  bool weld_vertices = false;  // STL: facets carry their own vertex copies
+  int index_base = 0;          // how the file numbers vertices (OBJ: 1), for messages
 
-  [[nodiscard]] std::int64_t num_vertices() const {
-    return static_cast<std::int64_t>(xyz.size() / 3);
-  }
-  [[nodiscard]] std::int64_t num_polygons() const {
-    return static_cast<std::int64_t>(offsets.size()) - 1;
-  }
+  [[nodiscard]] std::int64_t num_vertices() const { return static_cast<std::int64_t>(xyz.size() / 3); }
+  [[nodiscard]] std::int64_t num_polygons() const { return static_cast<std::int64_t>(offsets.size()) - 1; }
   void add_vertex(double x, double y, double z) {
     xyz.push_back(x);
     xyz.push_back(y);
     xyz.push_back(z);
   }
   void end_polygon() { offsets.push_back(static_cast<std::int64_t>(corners.size())); }
+  // Counts one more of `what` in not_kept.
+  void count_not_kept(std::string_view what, std::int64_t count = 1) {
+    for (auto& [name, n] : not_kept)
+      if (name == what) {
+        n += count;
+        return;
+      }
+    not_kept.emplace_back(what, count);
+  }
 };
 
 /// Throws IoError("name: message").
@@ -63,8 +70,7 @@ PolygonSoup parse_stl(ByteSource& source, const std::string& name, ReadReport& r
 bool has_binary_stl_size(std::string_view bytes);
 
 /// Validates the soup and turns it into a clean triangle mesh (see io.h for what is removed).
-Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& report,
-                  const ReadOptions& options);
+Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& report, const ReadOptions& options);
 
 /// Undirected edges of a polygon mesh, to keep quad diagonals from duplicating an edge.
 using EdgeSet = std::unordered_set<std::uint64_t>;
@@ -251,8 +257,7 @@ class TextScanner {
     if (!tok.empty() && tok.front() == '+') tok.remove_prefix(1);
     double value = 0;
     const auto [ptr, ec] = std::from_chars(tok.data(), tok.data() + tok.size(), value);
-    if (tok.empty() || ptr != tok.data() + tok.size() ||
-        (ec != std::errc() && ec != std::errc::result_out_of_range))
+    if (tok.empty() || ptr != tok.data() + tok.size() || (ec != std::errc() && ec != std::errc::result_out_of_range))
       error(std::string("expected ") + what + ", found '" + printable(tok) + "'");
     // from_chars leaves `value` unchanged (0) when the number does not fit a double, so
     // "1e999" used to read as 0. Such a number (overflow, or underflow below the smallest
@@ -269,19 +274,13 @@ class TextScanner {
       error(std::string("expected ") + what + ", found '" + printable(tok) + "'");
     return value;
   }
-  double next_double(const char* what, bool comments = false) {
-    return to_double(token(comments), what);
-  }
-  std::int64_t next_int(const char* what, bool comments = false) {
-    return to_int(token(comments), what);
-  }
+  double next_double(const char* what, bool comments = false) { return to_double(token(comments), what); }
+  std::int64_t next_int(const char* what, bool comments = false) { return to_int(token(comments), what); }
 
   /// Throws IoError("name: line N: message").
   [[noreturn]] void error(const std::string& message) const;
 
-  static bool is_space(char c) {
-    return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v';
-  }
+  static bool is_space(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\f' || c == '\v'; }
   /// At most 40 characters of a token, with control bytes replaced, for error messages.
   static std::string printable(std::string_view tok);
 

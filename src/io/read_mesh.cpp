@@ -329,6 +329,7 @@ Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& repor
   if (!soup.rgb.empty()) mesh.colors = Eigen::Map<const Colors>(soup.rgb.data(), nv, 3);
   mesh.vertex_properties = std::move(soup.properties);
   mesh.comments = std::move(soup.comments);
+  for (const auto& [what, count] : soup.not_kept) report.not_kept.push_back(fmt::format("{} ({})", what, count));
 
   // Remove unreferenced vertices, keeping the order of the others.
   std::vector<Index> new_index(static_cast<std::size_t>(nv), -1);
@@ -419,6 +420,12 @@ std::vector<std::string> ReadReport::warnings() const {
   add(repeated_index_faces_removed, "faces with a repeated vertex removed");
   add(duplicate_faces_removed, "duplicate faces removed");
   add(zero_area_faces_removed, "zero-area faces removed");
+  add(strip_triangles, "triangles read from triangle strips");
+  if (!not_kept.empty()) {
+    std::string list;
+    for (const std::string& item : not_kept) list += (list.empty() ? "" : ", ") + item;
+    out.push_back("not kept (the output has positions, faces, vertex colours and comments only): " + list);
+  }
   return out;
 }
 

@@ -1,6 +1,7 @@
 // Wavefront OBJ reader: `v` positions and `f` faces (v, v/t, v//n, v/t/n, negative indices),
 // and '#' comments (io.h); every other statement (vt, vn, g, o, s, usemtl, mtllib, l, p, ...)
-// is skipped.
+// is skipped, and those that carry attributes are counted in ReadReport::not_kept (until they
+// are kept: docs/attributes.md).
 //
 // A line whose last character other than blanks is a backslash continues on the next line, as
 // the OBJ specification allows (a long `f` statement split over lines). This holds for every
@@ -93,6 +94,27 @@ class ObjStatements {
   std::string held_;
 };
 
+// The attribute statements a mesh does not keep yet, by keyword (ReadReport::not_kept).
+void count_skipped_statement(std::string_view head, PolygonSoup& soup) {
+  const std::string_view keyword = head.substr(0, head.find_first_of(" \t\r\n\\"));
+  static constexpr std::pair<std::string_view, std::string_view> kinds[] = {{"vt", "texture coordinates vt"},
+                                                                            {"vn", "normals vn"},
+                                                                            {"usemtl", "material switches usemtl"},
+                                                                            {"mtllib", "material libraries mtllib"},
+                                                                            {"g", "groups g"},
+                                                                            {"o", "objects o"},
+                                                                            {"s", "smoothing groups s"},
+                                                                            {"vp", "parameter vertices vp"},
+                                                                            {"l", "lines l"}};
+  if (keyword == "s") {  // "s off" and "s 0" are no smoothing group
+    std::string_view rest = head.substr(1);
+    rest.remove_prefix(std::min(rest.find_first_not_of(" \t"), rest.size()));
+    if (rest.substr(0, 3) == "off" || rest.substr(0, 1) == "0") return;
+  }
+  for (const auto& [word, what] : kinds)
+    if (keyword == word) return soup.count_not_kept(what);
+}
+
 }  // namespace
 
 PolygonSoup parse_obj(ByteSource& source, const std::string& name) {
@@ -121,6 +143,8 @@ PolygonSoup parse_obj(ByteSource& source, const std::string& name) {
       // A comment's first line (a continued one's further lines are skipped with it).
       if (in.peek() == '#') [[unlikely]]
         in.peek_comment(soup.comments);
+      else
+        count_skipped_statement(in.lookahead(12), soup);
       statement.end();
       continue;
     }

@@ -29,29 +29,47 @@ std::optional<Type> parse_type(std::string_view s) {
 
 std::size_t type_size(Type t) {
   switch (t) {
-    case Type::Int8: case Type::UInt8: return 1;
-    case Type::Int16: case Type::UInt16: return 2;
-    case Type::Int32: case Type::UInt32: case Type::Float32: return 4;
-    case Type::Float64: return 8;
+    case Type::Int8:
+    case Type::UInt8:
+      return 1;
+    case Type::Int16:
+    case Type::UInt16:
+      return 2;
+    case Type::Int32:
+    case Type::UInt32:
+    case Type::Float32:
+      return 4;
+    case Type::Float64:
+      return 8;
   }
   return 0;
 }
 
-bool is_integer(Type t) { return t != Type::Float32 && t != Type::Float64; }
+bool is_integer(Type t) {
+  return t != Type::Float32 && t != Type::Float64;
+}
 
 // One value of type t, converted to R. List counts and indices are read with R = int64 (the
 // header check guarantees their types are integers).
 template <class R>
 R load_as(const char* p, Type t, bool swap) {
   switch (t) {
-    case Type::Int8: return static_cast<R>(static_cast<std::int8_t>(*p));
-    case Type::UInt8: return static_cast<R>(static_cast<std::uint8_t>(*p));
-    case Type::Int16: return static_cast<R>(load_scalar<std::int16_t>(p, swap));
-    case Type::UInt16: return static_cast<R>(load_scalar<std::uint16_t>(p, swap));
-    case Type::Int32: return static_cast<R>(load_scalar<std::int32_t>(p, swap));
-    case Type::UInt32: return static_cast<R>(load_scalar<std::uint32_t>(p, swap));
-    case Type::Float32: return static_cast<R>(load_scalar<float>(p, swap));
-    case Type::Float64: return static_cast<R>(load_scalar<double>(p, swap));
+    case Type::Int8:
+      return static_cast<R>(static_cast<std::int8_t>(*p));
+    case Type::UInt8:
+      return static_cast<R>(static_cast<std::uint8_t>(*p));
+    case Type::Int16:
+      return static_cast<R>(load_scalar<std::int16_t>(p, swap));
+    case Type::UInt16:
+      return static_cast<R>(load_scalar<std::uint16_t>(p, swap));
+    case Type::Int32:
+      return static_cast<R>(load_scalar<std::int32_t>(p, swap));
+    case Type::UInt32:
+      return static_cast<R>(load_scalar<std::uint32_t>(p, swap));
+    case Type::Float32:
+      return static_cast<R>(load_scalar<float>(p, swap));
+    case Type::Float64:
+      return static_cast<R>(load_scalar<double>(p, swap));
   }
   return 0;
 }
@@ -85,9 +103,13 @@ class PlyParser {
       if (element.name == "vertex") {
         read_vertices(element);
       } else if (element.name == "face") {
-        read_faces(element);
+        read_faces(element, /*strips=*/false);
+      } else if (element.name == "tristrips") {
+        read_faces(element, /*strips=*/true);
       } else {
         skip_element(element);
+        if (element.count > 0)
+          soup_.count_not_kept("PLY element '" + element.name + "'", static_cast<std::int64_t>(element.count));
       }
     }
     return std::move(soup_);
@@ -107,17 +129,20 @@ class PlyParser {
       } else if (keyword.empty() || keyword == "obj_info") {
       } else if (keyword == "format") {
         const std::string_view format = header.token_on_line();
-        if (format == "ascii") encoding_ = Encoding::Ascii;
-        else if (format == "binary_little_endian") encoding_ = Encoding::BinaryLittle;
-        else if (format == "binary_big_endian") encoding_ = Encoding::BinaryBig;
-        else header.error("unknown PLY format '" + TextScanner::printable(format) + "'");
+        if (format == "ascii")
+          encoding_ = Encoding::Ascii;
+        else if (format == "binary_little_endian")
+          encoding_ = Encoding::BinaryLittle;
+        else if (format == "binary_big_endian")
+          encoding_ = Encoding::BinaryBig;
+        else
+          header.error("unknown PLY format '" + TextScanner::printable(format) + "'");
         have_format = true;
       } else if (keyword == "element") {
         Element element;
         element.name = std::string(header.token_on_line());
         const std::string_view count = header.token_on_line();
-        if (element.name.empty() || count.empty() || count.front() == '-')
-          header.error("malformed element line");
+        if (element.name.empty() || count.empty() || count.front() == '-') header.error("malformed element line");
         element.count = static_cast<std::uint64_t>(header.to_int(count, "an element count"));
         // A second 'vertex' element would be read over the first, leaving soup_.rgb and the
         // scalar properties sized for the first one's count (heap overflow in soup_to_mesh).
@@ -154,8 +179,9 @@ class PlyParser {
     swap_ = (encoding_ == Encoding::BinaryBig) == host_is_little_endian();
     if (std::none_of(elements_.begin(), elements_.end(), [](const Element& e) { return e.name == "vertex"; }))
       fail(name_, "PLY header declares no vertex element");
-    if (std::none_of(elements_.begin(), elements_.end(), [](const Element& e) { return e.name == "face"; }))
-      fail(name_, "PLY header declares no face element (point clouds are not meshes)");
+    if (std::none_of(elements_.begin(), elements_.end(),
+                     [](const Element& e) { return e.name == "face" || e.name == "tristrips"; }))
+      fail(name_, "PLY header declares no face or tristrips element (point clouds are not meshes)");
   }
 
   // Returns the offset just past the "end_header" line and positions the body there. Reads
@@ -192,8 +218,10 @@ class PlyParser {
   std::uint64_t min_record_bytes(const Element& element) const {
     std::uint64_t bytes = 0;
     for (const Property& p : element.properties) {
-      if (encoding_ == Encoding::Ascii) bytes += 2;  // one character and a separator
-      else bytes += type_size(p.is_list ? p.count_type : p.type);
+      if (encoding_ == Encoding::Ascii)
+        bytes += 2;  // one character and a separator
+      else
+        bytes += type_size(p.is_list ? p.count_type : p.type);
     }
     return bytes;
   }
@@ -202,7 +230,8 @@ class PlyParser {
     const std::uint64_t min_bytes = min_record_bytes(element);
     const std::uint64_t available = source_.size_bound() - body_;
     // ASCII: the last record needs no trailing separator, hence the extra byte.
-    const std::uint64_t capacity = min_bytes == 0 ? 0 : (encoding_ == Encoding::Ascii ? available + 1 : available) / min_bytes;
+    const std::uint64_t capacity =
+        min_bytes == 0 ? 0 : (encoding_ == Encoding::Ascii ? available + 1 : available) / min_bytes;
     if (min_bytes > 0 && element.count > capacity)
       fail(name_, fmt::format("header declares {} '{}' elements, but the remaining {} bytes{} can hold at most {}",
                               element.count, element.name, available,
@@ -299,9 +328,12 @@ class PlyParser {
     for (const Property& p : element.properties) {
       Role role = Role::Skip;
       if (!p.is_list) {
-        if (p.name == "x") role = Role::X, has[0] = true;
-        else if (p.name == "y") role = Role::Y, has[1] = true;
-        else if (p.name == "z") role = Role::Z, has[2] = true;
+        if (p.name == "x")
+          role = Role::X, has[0] = true;
+        else if (p.name == "y")
+          role = Role::Y, has[1] = true;
+        else if (p.name == "z")
+          role = Role::Z, has[2] = true;
         else if (p.type == Type::UInt8 && (p.name == "red" || p.name == "green" || p.name == "blue")) {
           role = p.name == "red" ? Role::Red : p.name == "green" ? Role::Green : Role::Blue;
           ++color_channels;
@@ -331,10 +363,14 @@ class PlyParser {
       for (std::size_t i = 0; i < element.properties.size(); ++i) {
         const Property& p = element.properties[i];
         switch (roles[i]) {
-          case Role::X: case Role::Y: case Role::Z:
+          case Role::X:
+          case Role::Y:
+          case Role::Z:
             xyz[static_cast<std::size_t>(roles[i])] = next_value(p.type, "a vertex coordinate");
             break;
-          case Role::Red: case Role::Green: case Role::Blue: {
+          case Role::Red:
+          case Role::Green:
+          case Role::Blue: {
             const double c = next_value(p.type, "a vertex colour");
             // Declared uchar, but ASCII text can hold any number, and converting a double
             // outside 0..255 (or NaN) to uint8 is undefined behaviour. (Found by fuzz_read_ply.)
@@ -356,6 +392,8 @@ class PlyParser {
       end_record(element);
     }
     for (std::size_t i = 0; i < element.properties.size(); ++i) {
+      if (roles[i] == Role::Skip && n > 0)
+        soup_.count_not_kept("PLY vertex property '" + element.properties[i].name + "'", static_cast<std::int64_t>(n));
       if (roles[i] != Role::Scalar) continue;
       const std::vector<double>& values = scalars[scalar_slot[i]];
       soup_.properties.push_back(
@@ -365,7 +403,10 @@ class PlyParser {
     sync_ascii();
   }
 
-  void read_faces(const Element& element) {
+  // A `face` element (one polygon per record), or a `tristrips` element (Cyberware and Stanford
+  // scans: one or more strips per record, separated by -1; triangle i of a strip is corners
+  // (i, i+1, i+2), every other one turned round to keep the strip's orientation).
+  void read_faces(const Element& element, bool strips) {
     check_count(element);
     std::size_t index_property = element.properties.size();
     for (std::size_t i = 0; i < element.properties.size(); ++i) {
@@ -373,13 +414,16 @@ class PlyParser {
       if (p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index")) index_property = i;
     }
     if (index_property == element.properties.size())
-      fail(name_, "face element has no 'vertex_indices' list property");
+      fail(name_, element.name + " element has no 'vertex_indices' list property");
     if (!is_integer(element.properties[index_property].type))
-      fail(name_, "face vertex indices must have an integer type");
+      fail(name_, element.name + " vertex indices must have an integer type");
     const std::uint64_t n = element.count;
     const auto expected = static_cast<std::size_t>(n);  // bounded as in read_vertices
-    soup_.offsets.reserve(expected + 1);
-    soup_.corners.reserve(3 * expected);
+    if (!strips) {
+      soup_.offsets.reserve(expected + 1);
+      soup_.corners.reserve(3 * expected);
+    }
+    std::vector<Index> strip;
     for (std::uint64_t f = 0; f < n; ++f) {
       begin_record();
       for (std::size_t i = 0; i < element.properties.size(); ++i) {
@@ -389,17 +433,48 @@ class PlyParser {
           continue;
         }
         const std::uint64_t count = next_list_count(p);
+        strip.clear();
         for (std::uint64_t k = 0; k < count; ++k) {
           const std::int64_t index = next_integer(p.type, "a face vertex index");
+          // -1 ends a strip (as uint32, some writers' 4294967295).
+          if (strips && (index == -1 || (p.type == Type::UInt32 && index == 4294967295))) {
+            end_strip(strip);
+            continue;
+          }
           if (index < 0 || index > std::numeric_limits<Index>::max())
-            fail(name_, fmt::format("face {} has invalid vertex index {}", f, index));
-          soup_.corners.push_back(static_cast<Index>(index));
+            fail(name_, fmt::format("{} {} has invalid vertex index {}", element.name, f, index));
+          if (strips)
+            strip.push_back(static_cast<Index>(index));
+          else
+            soup_.corners.push_back(static_cast<Index>(index));
         }
+        if (strips) end_strip(strip);
       }
-      soup_.end_polygon();
+      if (!strips) soup_.end_polygon();
       end_record(element);
     }
+    for (std::size_t i = 0; i < element.properties.size(); ++i)
+      if (i != index_property && n > 0)
+        soup_.count_not_kept("PLY " + element.name + " property '" + element.properties[i].name + "'",
+                             static_cast<std::int64_t>(n));
     sync_ascii();
+  }
+
+  // The triangles of one strip, then an empty strip. A triangle with a repeated corner is how
+  // strips turn or jump (stitching), not a face: skipped.
+  void end_strip(std::vector<Index>& strip) {
+    for (std::size_t i = 2; i < strip.size(); ++i) {
+      const Index a = strip[i - 2], b = strip[i - 1], c = strip[i];
+      if (a == b || b == c || c == a) continue;
+      if (i % 2 == 0) {
+        soup_.corners.insert(soup_.corners.end(), {a, b, c});
+      } else {
+        soup_.corners.insert(soup_.corners.end(), {b, a, c});
+      }
+      soup_.end_polygon();
+      ++report_.strip_triangles;
+    }
+    strip.clear();
   }
 
   void skip_element(const Element& element) {

@@ -62,7 +62,7 @@ TEST(CliSimplify, BadInputFailsCleanly) {
   test::ScratchDir dir("cli-simplify-bad");
   const auto out = dir.file("out.off");
   expect_one_line_error(
-      run_cli("simplify " + quoted_data_path("spot.obj") + " " + shell_quote(out.string()) + " --ratio 0"),
+      run_cli("--quiet simplify " + quoted_data_path("spot.obj") + " " + shell_quote(out.string()) + " --ratio 0"),
       "spot.obj: simplify: the target ratio must be in (0, 1]");
   expect_one_line_error(run_cli("simplify /nonexistent/in.off " + shell_quote(out.string()) + " --faces 10"),
                         "/nonexistent/in.off: ");
@@ -124,9 +124,9 @@ TEST(CliRemeshAndSimplify, NonManifoldInputIsSplitWithAWarning) {
 TEST(CliRemesh, BadInputFailsCleanly) {
   test::ScratchDir dir("cli-remesh-bad");
   const auto out = dir.file("out.off");
-  expect_one_line_error(
-      run_cli("remesh " + quoted_data_path("spot.obj") + " " + shell_quote(out.string()) + " --edge-length 1e-7"),
-      "spot.obj: remesh: the edge length 1e-07 would give about");
+  expect_one_line_error(run_cli("--quiet remesh " + quoted_data_path("spot.obj") + " " + shell_quote(out.string()) +
+                                " --edge-length 1e-7"),
+                        "spot.obj: remesh: the edge length 1e-07 would give about");
   EXPECT_FALSE(std::filesystem::exists(out));
   EXPECT_NE(run_cli("remesh " + quoted_data_path("spot.obj") + " " + shell_quote(out.string())).exit_code, 0);
   EXPECT_NE(run_cli("remesh " + quoted_data_path("spot.obj") + " " + shell_quote(out.string()) + " --target-vertices 2")

@@ -90,7 +90,7 @@ const std::map<std::string, std::string> kExpected = {
     {"ply_unknown_keyword.ply", "line 3: unknown header keyword 'elemnt'"},
     {"ply_property_before_element.ply", "line 3: property before any element"},
     {"ply_not_ply.ply", "not a PLY file"},
-    {"ply_no_face_element.ply", "declares no face element"},
+    {"ply_no_face_element.ply", "declares no face or tristrips element"},
     {"ply_no_vertex_element.ply", "declares no vertex element"},
     {"ply_missing_z.ply", "vertex element lacks an x, y or z property"},
     {"ply_float_indices.ply", "face vertex indices must have an integer type"},

@@ -30,17 +30,17 @@ struct Expected {
 // (fandisk_quads: 764 quads -> 1528; chamfer-cube: 18 quads + 8 triangles -> 44;
 // suzanne: 468 quads + 32 triangles -> 968).
 const Expected kBundled[] = {
-    {"bunny.off", 34835, 69666, 0},          {"bunny_uniform.off", 8904, 17804, 0},
-    {"bunny_adaptive.off", 5884, 11764, 0},  {"amo.off", 90112, 180220, 0},
-    {"amo_adaptive.off", 5677, 11350, 0},    {"fandisk.off", 6475, 12946, 0},
-    {"fandisk_quads.off", 766, 1528, 764},   {"chamfer-cube.off", 24, 44, 18},
-    {"hemisphere.off", 1861, 3600, 0},       {"sphere.off", 16070, 32136, 0},
-    {"sphere_low.off", 589, 1174, 0},        {"icosahedron_ascii.stl", 12, 20, 0},
-    {"icosahedron_binary.stl", 12, 20, 0},   {"suzanne.obj", 507, 968, 468},
-    {"max-planck-5k.obj", 5272, 10540, 0},   {"armadillo-43k.obj", 43243, 86482, 0},
-    {"camelhead.off", 11381, 22704, 0},      {"fertility.off", 4494, 9000, 0},
-    {"torus.obj", 2304, 4608, 0},            {"horse-48k.ply", 48485, 96966, 0},
-    {"rocker-arm.obj", 10044, 20088, 0},     {"spot.obj", 2930, 5856, 0},
+    {"bunny.off", 34835, 69666, 0},         {"bunny_uniform.off", 8904, 17804, 0},
+    {"bunny_adaptive.off", 5884, 11764, 0}, {"amo.off", 90112, 180220, 0},
+    {"amo_adaptive.off", 5677, 11350, 0},   {"fandisk.off", 6475, 12946, 0},
+    {"fandisk_quads.off", 766, 1528, 764},  {"chamfer-cube.off", 24, 44, 18},
+    {"hemisphere.off", 1861, 3600, 0},      {"sphere.off", 16070, 32136, 0},
+    {"sphere_low.off", 589, 1174, 0},       {"icosahedron_ascii.stl", 12, 20, 0},
+    {"icosahedron_binary.stl", 12, 20, 0},  {"suzanne.obj", 507, 968, 468},
+    {"max-planck-5k.obj", 5272, 10540, 0},  {"armadillo-43k.obj", 43243, 86482, 0},
+    {"camelhead.off", 11381, 22704, 0},     {"fertility.off", 4494, 9000, 0},
+    {"torus.obj", 2304, 4608, 0},           {"horse-48k.ply", 48485, 96966, 0},
+    {"rocker-arm.obj", 10044, 20088, 0},    {"spot.obj", 2930, 5856, 0},
 };
 
 class BundledMesh : public ::testing::TestWithParam<Expected> {};
@@ -122,7 +122,8 @@ TEST_P(AgreesWithCgal, SameVerticesAndFaces) {
   for (Index f = 0; f < mesh.num_faces(); ++f) {
     ASSERT_EQ(polygons[static_cast<std::size_t>(f)].size(), 3u);
     for (int c = 0; c < 3; ++c)
-      ASSERT_EQ(static_cast<std::size_t>(mesh.F(f, c)), polygons[static_cast<std::size_t>(f)][static_cast<std::size_t>(c)]);
+      ASSERT_EQ(static_cast<std::size_t>(mesh.F(f, c)),
+                polygons[static_cast<std::size_t>(f)][static_cast<std::size_t>(c)]);
   }
 }
 
@@ -139,11 +140,11 @@ Mesh read_text(const std::string& text, MeshFormat format, ReadReport* report = 
 
 TEST(Cleanup, RemovesUnreferencedDuplicateRepeatedAndZeroAreaFaces) {
   const std::string obj =
-      "v 0 0 0\n"   // 1
-      "v 9 9 9\n"   // 2: unreferenced
-      "v 1 0 0\n"   // 3
-      "v 0 1 0\n"   // 4
-      "v 2 0 0\n"   // 5: collinear with 1 and 3
+      "v 0 0 0\n"  // 1
+      "v 9 9 9\n"  // 2: unreferenced
+      "v 1 0 0\n"  // 3
+      "v 0 1 0\n"  // 4
+      "v 2 0 0\n"  // 5: collinear with 1 and 3
       "f 1 3 4\n"
       "f 4 3 1\n"   // duplicate with the opposite orientation
       "f 3 1 4\n"   // duplicate (rotation)
@@ -216,7 +217,10 @@ TEST(ReadObj, ABackslashEndingALineContinuesTheStatement) {
     EXPECT_EQ(mesh.V, expected.V);
     EXPECT_EQ(mesh.F, expected.F);
     EXPECT_EQ(report.polygons_triangulated, 2);
-    EXPECT_EQ(report.warnings(), plain_report.warnings());  // the spec allows it: no warning
+    // The spec allows it: no warning (but the one naming the vn statement, which is not kept).
+    std::vector<std::string> warnings = report.warnings();
+    std::erase_if(warnings, [](const std::string& w) { return w.rfind("not kept", 0) == 0; });
+    EXPECT_EQ(warnings, plain_report.warnings());
   }
 }
 
@@ -335,10 +339,10 @@ TEST(Triangulation, NonConvexPolygonIsTriangulatedInside) {
   // from the first corner folds triangles over for both.
   const std::string off =
       "OFF\n11 2 0\n"
-      "0 0 0\n2 0 0\n2 1 1\n1 1 1\n1 2 2\n0 2 2\n"   // L, plane y = z
+      "0 0 0\n2 0 0\n2 1 1\n1 1 1\n1 2 2\n0 2 2\n"  // L, plane y = z
       "0 0 5\n4 0 5\n1 1 5\n4 4 5\n0 4 5\n"         // arrow, z = 5
-      "6 3 4 5 0 1 2\n"                                 // starts at the reflex corner's neighbour
-      "5 8 9 10 6 7\n";                                 // starts at the reflex corner
+      "6 3 4 5 0 1 2\n"                             // starts at the reflex corner's neighbour
+      "5 8 9 10 6 7\n";                             // starts at the reflex corner
   ReadReport report;
   const Mesh mesh = read_text(off, MeshFormat::Off, &report);
   EXPECT_EQ(report.polygons_triangulated, 2);
@@ -446,6 +450,72 @@ TEST(Cleanup, ZeroAreaFacesCanBeKept) {
   EXPECT_EQ(report.zero_area_faces_removed, 0);
   EXPECT_EQ(read_mesh_from_memory(obj, MeshFormat::Obj, "memory", &report).num_faces(), 1);
   EXPECT_EQ(report.zero_area_faces_removed, 1);
+}
+
+}  // namespace
+}  // namespace vertexflow
+
+namespace vertexflow {
+namespace {
+
+// PLY `tristrips` (Cyberware and Stanford scans): strips separated by -1 (or its uint32 spelling),
+// each triangle of a strip turned to keep the strip's orientation, the stitching triangles
+// (a repeated corner) skipped.
+TEST(ReadPly, TriangleStripsBecomeTriangles) {
+  // A 3 x 2 grid of the plane z = 0: 0 1 2 on y = 0, 3 4 5 on y = 1.
+  const std::string header =
+      "ply\nformat ascii 1.0\nelement vertex 6\nproperty float x\nproperty float y\nproperty float z\n"
+      "element tristrips 1\nproperty list int {} vertex_indices\nend_header\n"
+      "0 0 0\n1 0 0\n2 0 0\n0 1 0\n1 1 0\n2 1 0\n";
+  for (const auto& [type, restart] : {std::pair{"int", "-1"}, std::pair{"uint", "4294967295"}}) {
+    std::string text = header;
+    text.replace(text.find("{}"), 2, type);
+    // One strip over the first square, a restart, then one over the second that starts with
+    // two stitching triangles (4 4 4, 4 4 1), which are no faces.
+    text += std::string("11 3 0 4 1 ") + restart + " 4 4 4 1 5 2\n";
+    ReadReport report;
+    const Mesh mesh = read_mesh_from_memory(text, MeshFormat::Ply, "strips.ply", &report);
+    ASSERT_EQ(mesh.num_faces(), 4) << type;
+    EXPECT_EQ(report.strip_triangles, 4);
+    for (Index f = 0; f < 4; ++f)  // the strips' orientation: every face faces +z
+      EXPECT_GT(face_normal(mesh.V, mesh.F, f).z(), 0) << type << " face " << f;
+    // The four triangles cover both squares: total area 2.
+    double area = 0;
+    for (Index f = 0; f < 4; ++f) area += 0.5 * face_normal(mesh.V, mesh.F, f).norm();
+    EXPECT_DOUBLE_EQ(area, 2.0);
+  }
+}
+
+// What a file holds and the mesh does not keep is named, with counts, in one warning line.
+TEST(ReadReport, AttributesNotKeptAreNamed) {
+  const std::string obj =
+      "mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\ng part\n"
+      "usemtl red\ns 1\nf 1/1/1 2/2/1 3/3/1\nusemtl blue\nf 2/2/1 4/1/1 3/3/1\n";
+  ReadReport report;
+  (void)read_mesh_from_memory(obj, MeshFormat::Obj, "a.obj", &report);
+  const std::vector<std::string> expected = {
+      "material libraries mtllib (1)", "texture coordinates vt (3)", "normals vn (1)", "groups g (1)",
+      "material switches usemtl (2)",  "smoothing groups s (1)"};
+  EXPECT_EQ(report.not_kept, expected);
+  const std::vector<std::string> warnings = report.warnings();
+  ASSERT_EQ(warnings.size(), 1u);
+  EXPECT_NE(warnings[0].find("not kept"), std::string::npos);
+  EXPECT_NE(warnings[0].find("texture coordinates vt (3)"), std::string::npos);
+
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+      "property list uchar int neighbours\nelement face 1\nproperty list uchar int vertex_indices\n"
+      "property int material\nelement edge 2\nproperty int vertex1\nproperty int vertex2\nend_header\n"
+      "0 0 0 0\n1 0 0 0\n0 1 0 0\n3 0 1 2 7\n0 1\n1 2\n";
+  ReadReport ply_report;
+  (void)read_mesh_from_memory(ply, MeshFormat::Ply, "a.ply", &ply_report);
+  const std::vector<std::string> ply_expected = {"PLY vertex property 'neighbours' (3)",
+                                                 "PLY face property 'material' (1)", "PLY element 'edge' (2)"};
+  EXPECT_EQ(ply_report.not_kept, ply_expected);
+  // A file with nothing beyond positions and faces warns of nothing.
+  ReadReport plain;
+  (void)read_mesh(test::data_path("bunny_uniform.off"), &plain);
+  EXPECT_TRUE(plain.not_kept.empty());
 }
 
 }  // namespace
