@@ -49,14 +49,20 @@ void validate_flow_options(const FlowOptions& o, Index num_vertices) {
 
 namespace {
 
+// The true surface S of vertex_flow_on_reference, as the caller holds it (no copy).
+struct SurfaceView {
+  const Vertices& V;
+  const Faces& F;
+};
+
 FlowResult check_then(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options,
-                      const Mesh* reference);
+                      const SurfaceView* reference);
 
 // Flows the manifold split of a non-manifold or inconsistently oriented mesh (flow.h), on the
 // input or on the reference: the copies of held vertices are pinned, so every input vertex has
 // one position to return.
 FlowResult flow_on_manifold_split(const Vertices& V, const Faces& F, const Topology& topology,
-                                  const FlowOptions& options, const Mesh* reference) {
+                                  const FlowOptions& options, const SurfaceView* reference) {
   const ManifoldSplit split = split_non_manifold(V, F, topology);
   FlowOptions on_split = options;
   on_split.refuse_non_manifold = true;  // the split is manifold and oriented (manifold_split.h)
@@ -87,7 +93,7 @@ FlowResult flow_on_manifold_split(const Vertices& V, const Faces& F, const Topol
 // The rounds of vertex_flow on a manifold, oriented mesh with valid options: on the input, or
 // with frames, curvature and projection from the reference S (vertex_flow_on_reference).
 FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options,
-                       const Mesh* reference) {
+                       const SurfaceView* reference) {
   const Index n = static_cast<Index>(V.rows());
   FlowResult result;
   FlowReport& report = result.report;
@@ -126,10 +132,7 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
   // The guard puts the vertices it shortens back onto the input (those of the flow on S are not
   // projected onto S).
   Reprojection reproject;
-  if (options.project_to_input && !surface)
-    reproject = [&](Vertices& Y, const std::vector<Index>& rows) {
-      project_near_vertices(Y, rows, input, F, topology, setup.features);
-    };
+  if (options.project_to_input && !surface) reproject = project;
   // The surface's curvature at the input positions, for the density passes.
   Curvature surface_curvature;
   for (int round = 0; round < options.iterations; ++round) {
@@ -206,7 +209,7 @@ namespace {
 // vertex_flow's checks, then the rounds (on the manifold split of a non-manifold mesh when
 // options allow), on the input or on the reference.
 FlowResult check_then(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options,
-                      const Mesh* reference) {
+                      const SurfaceView* reference) {
   const Index n = static_cast<Index>(V.rows());
   validate_flow_options(options, n);
   if (n == 0 || F.rows() == 0) throw std::invalid_argument("vertex flow: the mesh is empty");
@@ -243,9 +246,7 @@ FlowResult vertex_flow_on_reference(const Vertices& V, const Faces& F, const Ver
     throw std::invalid_argument("vertex flow on a reference: a vertex of the reference has a non-finite coordinate");
   if (V.rows() == 0 || F.rows() == 0) throw std::invalid_argument("vertex flow: the mesh is empty");
   const Topology topology = build_topology(F, static_cast<Index>(V.rows()));
-  Mesh reference;
-  reference.V = VS;
-  reference.F = FS;
+  const SurfaceView reference{VS, FS};
   return check_then(V, F, topology, options, &reference);
 }
 
