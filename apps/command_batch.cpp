@@ -7,10 +7,10 @@
 
 #include <fmt/format.h>
 
-#include <algorithm>
 #include <cstdio>
 #include <memory>
 #include <stdexcept>
+#include <utility>
 
 #include <unistd.h>
 
@@ -77,10 +77,9 @@ void register_batch_command(CLI::App& app, const GlobalOptions& global) {
     o->batch.reference_dir = o->reference_dir;
     o->batch.output_dir = o->output_dir;
     o->batch.file.enhance = enhance_options_from(o->given);
-    const bool references =
-        !o->reference_dir.empty() || std::any_of(o->batch.items.begin(), o->batch.items.end(),
-                                                 [](const BatchItem& item) { return !item.reference.empty(); });
-    validate_enhance_options(o->batch.file.enhance, references, -1, OptionNaming::Cli);
+    // run_batch decides the mode from the files' references and checks the options, in the
+    // flags' words, before any file is read.
+    o->batch.naming = OptionNaming::Cli;
     o->batch.file.metrics = !o->no_metrics;
     const bool tty = ::isatty(STDERR_FILENO) == 1;
     if (!global.quiet) {

@@ -335,21 +335,24 @@ std::vector<std::filesystem::path> batch_inputs(const std::vector<std::string>& 
 
 namespace {
 
-// The reference of `input` in `directory`: the file with the input's stem and a mesh extension
-// (the first by name), or empty.
-std::filesystem::path reference_in(const std::filesystem::path& directory, const std::filesystem::path& input) {
+// A mesh file's name without its extensions (".gz" and the format's): "bunny" for bunny.off.gz.
+std::string mesh_stem(const std::filesystem::path& path) {
+  const std::filesystem::path name = path.filename();
+  return (is_gzip_path(name) ? name.stem() : name).stem().string();
+}
+
+// The mesh files of `directory` by stem, the first by name where several share one. Listed once
+// for the whole batch, not once per input.
+std::map<std::string, std::filesystem::path> references_by_stem(const std::filesystem::path& directory) {
   std::error_code ec;
-  std::vector<std::filesystem::path> matches;
-  for (const auto& entry : std::filesystem::directory_iterator(directory, ec)) {
-    const std::filesystem::path& p = entry.path();
-    std::filesystem::path stem = p.filename();
-    if (is_gzip_path(stem)) stem = stem.stem();
-    if (stem.stem() == input.filename().stem() || stem.stem() == input.filename().stem().stem())
-      if (entry.is_regular_file(ec) && is_mesh_path(p)) matches.push_back(p);
-  }
+  std::vector<std::filesystem::path> meshes;
+  for (const auto& entry : std::filesystem::directory_iterator(directory, ec))
+    if (entry.is_regular_file(ec) && is_mesh_path(entry.path())) meshes.push_back(entry.path());
   if (ec) throw IoError(directory.string() + ": cannot list the reference directory: " + ec.message());
-  std::sort(matches.begin(), matches.end());
-  return matches.empty() ? std::filesystem::path() : matches.front();
+  std::sort(meshes.begin(), meshes.end());
+  std::map<std::string, std::filesystem::path> by_stem;
+  for (const std::filesystem::path& mesh : meshes) by_stem.emplace(mesh_stem(mesh), mesh);
+  return by_stem;
 }
 
 }  // namespace
@@ -361,10 +364,13 @@ std::vector<BatchItem> batch_items(const BatchOptions& options) {
   std::error_code ec;
   if (!options.reference_dir.empty() && !std::filesystem::is_directory(options.reference_dir, ec))
     throw IoError(options.reference_dir.string() + ": is not a directory (the reference directory)");
+  const std::map<std::string, std::filesystem::path> references = options.reference_dir.empty()
+                                                                      ? std::map<std::string, std::filesystem::path>{}
+                                                                      : references_by_stem(options.reference_dir);
   for (BatchItem& item : items) {
     if (item.output.empty()) item.output = options.output_dir / item.input.filename();
-    if (item.reference.empty() && !options.reference_dir.empty())
-      item.reference = reference_in(options.reference_dir, item.input);
+    if (const auto it = references.find(mesh_stem(item.input)); item.reference.empty() && it != references.end())
+      item.reference = it->second;
   }
   return items;
 }
