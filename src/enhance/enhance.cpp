@@ -341,7 +341,6 @@ void validate_enhance_options(const EnhanceOptions& options, bool has_reference,
   // The ranges, in the table's words first (the front ends' names), then the methods' own
   // checks of what the table does not hold.
   for (const EnhanceOptionSpec& spec : enhance_option_specs()) check_option_value(spec, spec.get(options), naming);
-  validate_vertex_constraints(options.constraints, num_vertices, "enhance");
   switch (mode) {
     case EnhanceMode::Flow:
     case EnhanceMode::ReferenceFlow:
@@ -353,8 +352,9 @@ void validate_enhance_options(const EnhanceOptions& options, bool has_reference,
     case EnhanceMode::Smooth:
       validate_fit_options(effective_smooth_options(options).fit, num_vertices, "fit to smooth surface");
       break;
-    case EnhanceMode::Unsharp:
-      break;  // unsharp_mask checks its two numbers itself
+    case EnhanceMode::Unsharp:  // the table checked its two numbers; its pins here
+      validate_vertex_constraints(options.constraints, num_vertices, "unsharp mask");
+      break;
   }
 }
 

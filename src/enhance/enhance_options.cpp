@@ -35,18 +35,12 @@ EnhanceOptionSpec member_spec(std::string_view name, std::string_view cpp, std::
   s.get = [member](const EnhanceOptions& o) -> OptionValue {
     const auto& v = member(o);
     using T = std::decay_t<decltype(v)>;
-    if constexpr (std::is_same_v<T, bool>)
-      return v;
-    else if constexpr (std::is_same_v<T, double>)
-      return v;
-    else if constexpr (std::is_same_v<T, std::vector<Index>>)
+    if constexpr (std::is_same_v<T, bool> || std::is_same_v<T, double> || std::is_same_v<T, std::vector<Index>>)
       return v;
     else if constexpr (std::is_same_v<T, std::optional<int>>)
       return v ? OptionValue(static_cast<long long>(*v)) : OptionValue();
-    else if constexpr (std::is_integral_v<T>)
-      return static_cast<long long>(v);
     else
-      return static_cast<long long>(v);  // an enum: its index (Choice)
+      return static_cast<long long>(v);  // an integer, or an enum's value (choice() names it)
   };
   s.set = [member](EnhanceOptions& o, const OptionValue& value) {
     auto& v = member(o);
@@ -63,10 +57,9 @@ EnhanceOptionSpec member_spec(std::string_view name, std::string_view cpp, std::
         v.reset();
       else
         v = static_cast<int>(std::get<long long>(value));
-    } else if constexpr (std::is_integral_v<T>)
-      v = static_cast<T>(std::get<long long>(value));
-    else
-      v = static_cast<T>(std::get<long long>(value));  // an enum from its index
+    } else {
+      v = static_cast<T>(std::get<long long>(value));  // an integer, or an enum from its value
+    }
   };
   return s;
 }
