@@ -30,8 +30,9 @@ void use_single_threaded_blas() {
 // at once: CHOLMOD's default ordering tries METIS, whose random number state is global, and
 // Debian's serial OpenBLAS (the BLAS of the supernodal factorisation) is not built for
 // concurrent callers. Measured with `batch --manifest M --jobs 2` over four reference fits
-// (each round factorises): without turns, bunny_adaptive's output had 3 different hashes in 4
-// runs and amo_adaptive once failed as "not positive definite". A batch's jobs still overlap
+// (each round factorises): without turns, amo_adaptive's output had 3 different hashes in 4 runs
+// (bunny_adaptive's 2); with only the orderings taking turns, amo_adaptive failed in 1 run of 5
+// as "not positive definite". A batch's jobs still overlap
 // everything else (queries, the guard, I/O); the factorisations of a fit are 30% of its time.
 std::mutex& cholmod_mutex() {
   static std::mutex mutex;

@@ -138,8 +138,8 @@ TEST(Batch, EveryModeWritesWhatEnhanceWrites) {
 
 // Jobs run at once in one process and each fit factorises every round: the bytes must not depend
 // on what runs beside them. Without CHOLMOD's calls taking turns (sparse_cholesky.cpp), these
-// pairs gave bunny_adaptive 3 different outputs in 4 runs at --jobs 2, and amo_adaptive once
-// failed as not positive definite.
+// pairs gave amo_adaptive 3 different outputs (bunny_adaptive 2) in 4 runs at --jobs 2, and with
+// only the orderings taking turns amo_adaptive once failed as not positive definite.
 TEST(Batch, ConcurrentJobsWriteTheBytesOfOneJob) {
   test::ScratchDir dir("batch-jobs");
   const auto manifest = dir.file("pairs.csv");
