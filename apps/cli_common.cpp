@@ -1,6 +1,7 @@
 #include "cli_common.h"
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -69,16 +70,38 @@ bool names_an_input(std::string_view message) {
   return false;
 }
 
-Mesh read_mesh_with_warnings(const std::filesystem::path& path, const GlobalOptions& global, ReadReport* report) {
+Mesh read_mesh_with_warnings(const std::filesystem::path& path, const GlobalOptions& global, ReadReport* report,
+                             const ReadOptions& options) {
   inputs_read().push_back(path.string());
   ReadReport local;
   ReadReport& r = report ? *report : local;
-  Mesh mesh = read_mesh(path, &r);
+  Mesh mesh = read_mesh(path, &r, options);
   if (!global.quiet) {
     for (const std::string& warning : r.warnings())
       fmt::print(stderr, "vertexflow: warning: {}: {}\n", path.string(), warning);
   }
   return mesh;
+}
+
+void write_mesh_with_warnings(const std::filesystem::path& path, const Mesh& mesh, const GlobalOptions& global) {
+  const std::vector<std::string> lost = attributes_not_written(mesh, format_from_path(path));
+  if (!lost.empty() && !global.quiet)
+    fmt::print(stderr, "vertexflow: warning: {}: {} cannot hold, so it does not get: {}\n", path.string(),
+               format_name(format_from_path(path)), fmt::join(lost, ", "));
+  write_mesh(path, mesh);
+}
+
+void warn_attributes_dropped(const std::filesystem::path& input, const Mesh& mesh, const char* what,
+                             const GlobalOptions& global) {
+  std::vector<std::string> names;
+  for (const AttributeChannel& c : mesh.attributes.vertex) names.push_back("vertex " + c.name);
+  for (const CornerChannel& c : mesh.attributes.corner) names.push_back("corner " + c.channel.name);
+  for (const AttributeChannel& c : mesh.attributes.face) names.push_back("face " + c.name);
+  if (!names.empty() && !global.quiet)
+    fmt::print(stderr,
+               "vertexflow: warning: {}: {} builds new faces and vertices and does not carry the input's attributes: "
+               "{} (enhance keeps them)\n",
+               input.string(), what, fmt::join(names, ", "));
 }
 
 std::string describe_format(const ReadReport& report) {

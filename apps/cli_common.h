@@ -28,7 +28,16 @@ struct GlobalOptions {
 
 /// Reads a mesh and prints one warning line per cleanup count to stderr (unless quiet).
 Mesh read_mesh_with_warnings(const std::filesystem::path& path, const GlobalOptions& global,
-                             ReadReport* report = nullptr);
+                             ReadReport* report = nullptr, const ReadOptions& options = {});
+
+/// Writes `mesh` to `path` (write_mesh), first printing one warning line naming what the
+/// output's format cannot hold (attributes_not_written), unless quiet.
+void write_mesh_with_warnings(const std::filesystem::path& path, const Mesh& mesh, const GlobalOptions& global);
+
+/// One warning line, unless quiet, when `input` carries attributes a command that builds new
+/// connectivity (`what`: "remesh", "simplify") does not carry.
+void warn_attributes_dropped(const std::filesystem::path& input, const Mesh& mesh, const char* what,
+                             const GlobalOptions& global);
 
 /// A file a subcommand writes.
 struct OutputFile {

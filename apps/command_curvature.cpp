@@ -71,14 +71,14 @@ void register_curvature_command(CLI::App& app, const GlobalOptions& global) {
     if (o->color != "none") {
       const Eigen::VectorXd& values = quantities.at(o->color);
       limit = robust_color_limit(values);
-      mesh.colors = diverging_colors(values, limit);
+      mesh.set_vertex_colors(diverging_colors(values, limit));
       if (!global.quiet && !o->json)
         fmt::print(stderr, "vertexflow: colour range for {}: [{:.6g}, {:.6g}] (5th-95th percentile magnitude)\n",
                    o->color, o->color == "abs" ? 0.0 : -limit, limit);
     }
     if (format_from_path(o->output) != MeshFormat::Ply && !global.quiet)
       fmt::print(stderr, "vertexflow: warning: {}: only PLY stores per-vertex properties; writing geometry{}\n",
-                 o->output, mesh.colors.rows() ? " and colours" : "");
+                 o->output, mesh.vertex_colors().rows() ? " and colours" : "");
     write_mesh(o->output, mesh);
     if (o->json) {
       nlohmann::json out;

@@ -169,7 +169,10 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     };
     auto start = Clock::now();
     phase("reading " + o->input);
-    const Mesh mesh = read_mesh_with_warnings(o->input, global);
+    // The face list as the file has it (enhance.h holds what the methods cannot work on).
+    ReadOptions keep_faces;
+    keep_faces.keep_face_list = true;
+    const Mesh mesh = read_mesh_with_warnings(o->input, global, nullptr, keep_faces);
     const double seconds_read = seconds_since(start);
     if (!o->pin_file.empty()) options.constraints.pinned = read_pins(o->pin_file, mesh.num_vertices());
     std::optional<ReferenceSurface> reference;
@@ -196,7 +199,7 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
                  o->output, result.provenance);
     start = Clock::now();
     phase("writing " + o->output);
-    write_mesh(o->output, out);
+    write_mesh_with_warnings(o->output, out, global);
     const double seconds_write = seconds_since(start);
 
     if (o->report_file.empty() && o->html_file.empty()) return;

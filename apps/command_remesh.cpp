@@ -52,6 +52,7 @@ void register_remesh_command(CLI::App& app, const GlobalOptions& global) {
   command->callback([o, &global] {
     check_outputs({o->input}, {{o->output, /*mesh=*/true, /*may_replace_input=*/true}}, o->force);
     const Mesh mesh = read_mesh_with_warnings(o->input, global);
+    warn_attributes_dropped(o->input, mesh, "remesh", global);
     RemeshResult result;
     try {
       if (o->edge_length > 0) {

@@ -39,6 +39,7 @@ void register_simplify_command(CLI::App& app, const GlobalOptions& global) {
   command->callback([o, &global] {
     check_outputs({o->input}, {{o->output, /*mesh=*/true, /*may_replace_input=*/true}}, o->force);
     const Mesh mesh = read_mesh_with_warnings(o->input, global);
+    warn_attributes_dropped(o->input, mesh, "simplify", global);
     o->simplify.keep_boundary = !o->free_boundary;
     SimplifyResult result;
     try {

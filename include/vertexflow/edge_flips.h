@@ -23,6 +23,9 @@
 #include "vertexflow/distance.h"
 #include "vertexflow/mesh.h"
 
+#include <array>
+#include <vector>
+
 namespace vertexflow {
 
 struct EdgeFlipOptions {
@@ -32,6 +35,9 @@ struct EdgeFlipOptions {
   /// near-planar pairs from flipping back and forth).
   double min_gain = 0.05;
   int max_passes = 5;
+  /// Edges never flipped (vertex pairs, either order): texture seams and boundaries between
+  /// faces of different materials or labels, so that every face keeps one chart and one label.
+  std::vector<std::array<Index, 2>> fixed_edges;
 };
 
 struct EdgeFlipReport {

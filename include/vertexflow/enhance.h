@@ -131,9 +131,9 @@ struct EnhanceCallbacks {
 };
 
 struct EnhanceResult {
-  /// The result: the input's faces (or the flipped faces: same count, each face keeping its
-  /// index, edge_flips.h), its colours, and its comments with this run's provenance line
-  /// appended (provenance.h).
+  /// The result: the input's face list, exactly (or the flipped faces: same count, each face
+  /// keeping its index, edge_flips.h), its attributes re-sampled where vertices moved
+  /// (attributes.h), and its comments with this run's provenance line appended (provenance.h).
   Mesh mesh;
   EnhanceMode mode = EnhanceMode::Flow;
   /// The report's method sections: "method", "options", what the method reported (solver,
@@ -150,11 +150,20 @@ struct EnhanceResult {
   std::vector<std::string> warnings;
 };
 
-/// Runs the mode `options` choose on `mesh` (its V, F, colours and comments; the comments'
+/// Runs the mode `options` choose on `mesh` (its V, F, attributes and comments; the comments'
 /// provenance lines let smooth mode hold an input that an earlier fit placed off its surface),
 /// with `reference` for the reference modes (nullptr otherwise). Validates first
-/// (validate_enhance_options, OptionNaming::Cpp) and throws as the chosen method does
-/// (std::invalid_argument for a mesh it refuses).
+/// (validate_enhance_options, OptionNaming::Cpp; MeshAttributes::validate, as an
+/// EnhanceOptionError) and throws as the chosen method does (std::invalid_argument for a mesh it
+/// refuses).
+///
+/// The face list comes back as it went in. Faces the methods cannot work on (a repeated vertex,
+/// zero area by mesh.h's bound, a repeat of an earlier face) stay in it, and their vertices are
+/// held, as are vertices without faces (the report's "face_list" counts them). Chart boundaries
+/// (texture seams, material and other label boundaries: docs/attributes.md) are creases for
+/// the flow (VertexConstraints::crease_edges) and are never flipped. Each moved vertex's
+/// attributes are re-sampled where it lands on the input surface, in each of its charts
+/// (the report's "attributes" section says how many and how far).
 EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const EnhanceOptions& options,
                       const EnhanceCallbacks& callbacks = {});
 

@@ -7,6 +7,7 @@
 #include "vertexflow/mesh.h"
 #include "vertexflow/topology.h"
 
+#include <array>
 #include <vector>
 
 namespace vertexflow {
@@ -29,7 +30,11 @@ struct SurfaceFeatures {
   Vertices vertex_normals;  ///< of the mesh (curvature.h), for the Phong height of projections
 };
 
-/// Features for `angle_degrees` (>= 180 marks nothing sharp).
-SurfaceFeatures detect_features(const Vertices& V, const Faces& F, const Topology& topology, double angle_degrees);
+/// Features for `angle_degrees` (>= 180 marks nothing sharp by angle). The interior edges in
+/// `crease_edges` (vertex pairs, either order; pairs that are no interior edge are ignored) are
+/// sharp whatever their angle and are never dropped as short chains or as ending in one patch:
+/// texture seams and material boundaries (VertexConstraints::crease_edges, guard.h).
+SurfaceFeatures detect_features(const Vertices& V, const Faces& F, const Topology& topology, double angle_degrees,
+                                const std::vector<std::array<Index, 2>>& crease_edges = {});
 
 }  // namespace vertexflow

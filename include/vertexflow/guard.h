@@ -7,6 +7,7 @@
 
 #include "vertexflow/mesh.h"
 
+#include <array>
 #include <vector>
 
 namespace vertexflow {
@@ -17,6 +18,12 @@ struct VertexConstraints {
   bool fix_boundary = true;
   /// Vertices held in place (indices into V).
   std::vector<Index> pinned;
+  /// Edges (pairs of vertex indices, either order) that the flow treats as creases whatever
+  /// their dihedral angle: a vertex on one slides only along it, and a vertex where three or
+  /// more meet, or where one ends, stays. `enhance` fills it with texture seams and material
+  /// boundaries (attributes.h) so that no vertex crosses into another chart. Pairs that are no
+  /// edge of the mesh are ignored.
+  std::vector<std::array<Index, 2>> crease_edges;
 };
 
 /// The guard that follows every solve of the flow and the fit: it repairs every flipped or

@@ -86,6 +86,12 @@ struct ReadOptions {
   std::uint64_t inflate_floor_bytes = std::uint64_t{64} << 20;
   /// Remove faces whose area is below kDegenerateAreaRelative * diagonal^2.
   bool remove_zero_area_faces = true;
+  /// Keep the file's face list and vertex list as they are: no face or vertex is removed
+  /// (zero-area, repeated-index and duplicate faces and unreferenced vertices stay, counted in
+  /// ReadReport's *_kept), so that anything indexed by face or vertex still lines up. Polygons
+  /// are still triangulated, in place. `enhance` reads this way and holds the vertices of such
+  /// faces (enhance.h).
+  bool keep_face_list = false;
 };
 
 /// What reading had to change to produce a clean triangle mesh. Every count is also a warning.
@@ -114,10 +120,13 @@ struct ReadReport {
   /// Triangles read from PLY `tristrips` elements (strips with -1 restarts; the strips'
   /// degenerate stitching triangles are not faces and are skipped).
   std::int64_t strip_triangles = 0;
-  /// What the file holds that the mesh does not keep, one entry each with its count, e.g.
-  /// "vt (3225 texture coordinates)", "PLY face property 'material'", in the order first met.
-  /// Until attributes are carried (docs/attributes.md, issue 28) they are named here, so that
-  /// no command drops them without a warning.
+  /// With ReadOptions::keep_face_list: the faces and vertices that would have been removed.
+  std::int64_t degenerate_faces_kept = 0;
+  std::int64_t duplicate_faces_kept = 0;
+  std::int64_t unreferenced_vertices_kept = 0;
+  /// What the file holds that the mesh does not keep (attributes.h keeps every vertex and face
+  /// property and OBJ's texture coordinates, normals, materials and groups), one entry each with
+  /// its count, e.g. "PLY element 'edge' (12)", "OBJ lines l (3)", in the order first met.
   std::vector<std::string> not_kept;
 
   /// One human-readable line per non-zero count, e.g. "3 duplicate faces removed", and one line
@@ -147,8 +156,11 @@ struct WriteOptions {
   bool off_binary = false;
   /// Write per-vertex colours where the format can carry them (PLY, OFF as COFF).
   bool write_colors = true;
-  /// Write per-vertex scalar properties (PLY only; other formats ignore them).
+  /// Write the vertex channels other than colours (PLY; OBJ's per-vertex texture coordinates
+  /// and normals).
   bool write_vertex_properties = true;
+  /// Write corner and face channels, materials, groups and material libraries (OBJ, PLY).
+  bool write_attributes = true;
 };
 
 /// Writes a mesh, format chosen by extension (".gz" compresses). Mesh::comments are written
@@ -165,6 +177,12 @@ struct WriteOptions {
 /// removes on SIGINT and SIGTERM before the process dies of the signal; the handler is installed
 /// only over the default disposition, never over a program's own handler or SIG_IGN.
 void write_mesh(const std::filesystem::path& path, const Mesh& mesh, const WriteOptions& options = {});
+
+/// What write_mesh would leave out of a file of `format`, one entry per channel ("corner
+/// normal", "face quality", "material names"): STL holds none, OFF one colour, OBJ texture
+/// coordinates, normals, materials, groups, objects and smoothing groups, PLY every vertex and
+/// face channel and one two-component texture coordinate per corner. Empty when nothing is lost.
+std::vector<std::string> attributes_not_written(const Mesh& mesh, MeshFormat format, const WriteOptions& options = {});
 
 /// Writes `text` to `path` atomically (temporary file beside it, then rename). Throws IoError.
 void write_text_file(const std::filesystem::path& path, std::string_view text);

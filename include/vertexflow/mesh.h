@@ -12,8 +12,11 @@
 //   the signed volume is positive.
 // - Both matrices are row-major so a vertex or face is contiguous in memory; they interoperate
 //   with libigl-style V/F (Eigen::MatrixXd / Eigen::MatrixXi) by plain assignment.
-// - Per-vertex data (properties, colours) is aligned with the rows of V.
+// - Per-vertex data (properties, colours) is aligned with the rows of V, per-face data with the
+//   rows of F (attributes.h).
 #pragma once
+
+#include "vertexflow/attributes.h"
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
@@ -38,25 +41,18 @@ using Faces = Eigen::Matrix<Index, Eigen::Dynamic, 3, Eigen::RowMajor>;
 /// 8-bit RGB colours, one row per vertex.
 using Colors = Eigen::Matrix<std::uint8_t, Eigen::Dynamic, 3, Eigen::RowMajor>;
 
-/// A named scalar per vertex (e.g. "k1", "quality"); values.size() equals the vertex count.
-struct VertexProperty {
-  std::string name;
-  Eigen::VectorXd values;
-};
-
 /// Relative area below which a triangle counts as degenerate: area < kDegenerateAreaRelative *
 /// (bounding-box diagonal)^2. The same bound is used when reading (such faces are removed) and
 /// when measuring a result (docs/metrics.md, "degenerate faces").
 inline constexpr double kDegenerateAreaRelative = 1e-12;
 
-/// A triangle mesh with optional per-vertex data.
+/// A triangle mesh with what it carries: texture coordinates, normals, colours, labels and any
+/// other property (attributes.h), and comment lines.
 struct Mesh {
   Vertices V;
   Faces F;
-  /// Optional per-vertex colours; empty (0 rows) or #V rows.
-  Colors colors;
-  /// Optional per-vertex scalar properties, written to PLY as `property double NAME`.
-  std::vector<VertexProperty> vertex_properties;
+  /// Per-vertex, per-corner and per-face channels and the names they index.
+  MeshAttributes attributes;
   /// Free-text comment lines, in file order, without the comment marker: PLY `comment` lines,
   /// OBJ and OFF `#` lines (io.h says which, and how many are kept). `vertexflow enhance` keeps
   /// its input's and adds one recording how the vertices were placed (provenance.h). Each is
@@ -66,10 +62,17 @@ struct Mesh {
   [[nodiscard]] Index num_vertices() const { return static_cast<Index>(V.rows()); }
   [[nodiscard]] Index num_faces() const { return static_cast<Index>(F.rows()); }
 
-  /// Adds or replaces the property called `name`. `values.size()` must equal num_vertices().
-  void set_vertex_property(std::string name, Eigen::VectorXd values);
-  /// The property called `name`, or nullptr.
-  [[nodiscard]] const VertexProperty* find_vertex_property(std::string_view name) const;
+  /// Adds or replaces the one-component Float64 vertex channel called `name` (written to PLY as
+  /// `property double NAME`). `values.size()` must equal num_vertices(); throws
+  /// std::invalid_argument otherwise.
+  void set_vertex_property(std::string name, const Eigen::VectorXd& values);
+  /// The one-component vertex channel called `name` as a column, or nullptr.
+  [[nodiscard]] const AttributeChannel* find_vertex_property(std::string_view name) const;
+  /// Adds or replaces the vertex channel "color" (role Color, uint8 red green blue).
+  void set_vertex_colors(const Colors& colors);
+  /// The first Color vertex channel as 8-bit RGB (float colours in [0, 1] are scaled by 255), or
+  /// an empty matrix.
+  [[nodiscard]] Colors vertex_colors() const;
 };
 
 /// Axis-aligned bounding box of the vertices. For an empty mesh min = max = 0.

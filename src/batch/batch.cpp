@@ -36,10 +36,13 @@ std::string error_line(const std::filesystem::path& input, const std::string& wh
   return what.compare(0, prefix.size(), prefix) == 0 ? what : prefix + what;
 }
 
-// Reads a mesh, naming the file in the warnings.
-Mesh read_with_warnings(const std::filesystem::path& path, std::vector<std::string>& warnings) {
+// Reads a mesh, naming the file in the warnings; with `keep_faces`, its face list as it is
+// (ReadOptions::keep_face_list), as `vertexflow enhance` reads its input.
+Mesh read_with_warnings(const std::filesystem::path& path, std::vector<std::string>& warnings, bool keep_faces) {
   ReadReport report;
-  Mesh mesh = read_mesh(path, &report);
+  ReadOptions options;
+  options.keep_face_list = keep_faces;
+  Mesh mesh = read_mesh(path, &report, options);
   for (const std::string& w : report.warnings()) warnings.push_back(w);
   return mesh;
 }
@@ -48,11 +51,11 @@ void run_file(const std::filesystem::path& input, const std::filesystem::path& o
               const std::filesystem::path& reference_path, const BatchFileOptions& options, BatchRow& row) {
   auto start = Clock::now();
   std::vector<std::string> warnings;
-  const Mesh mesh = read_with_warnings(input, warnings);
+  const Mesh mesh = read_with_warnings(input, warnings, true);
   std::optional<ReferenceSurface> reference;
   if (!reference_path.empty()) {
     std::vector<std::string> reference_warnings;
-    Mesh dense = read_with_warnings(reference_path, reference_warnings);
+    Mesh dense = read_with_warnings(reference_path, reference_warnings, false);
     for (const std::string& w : reference_warnings) warnings.push_back(reference_path.string() + ": " + w);
     reference.emplace(std::move(dense.V), std::move(dense.F), reference_path.string());
   }
@@ -77,6 +80,13 @@ void run_file(const std::filesystem::path& input, const std::filesystem::path& o
 
   // The bytes `vertexflow enhance` writes: the engine's mesh, write_mesh's defaults.
   start = Clock::now();
+  const std::vector<std::string> lost = attributes_not_written(result.mesh, format_from_path(output));
+  if (!lost.empty()) {
+    std::string list;
+    for (const std::string& l : lost) list += (list.empty() ? "" : ", ") + l;
+    warnings.push_back(std::string(format_name(format_from_path(output))) + " cannot hold, so the output does not get: " + list);
+    row.warnings = join(warnings);
+  }
   write_mesh(output, result.mesh);
   row.seconds_write = seconds_since(start);
 

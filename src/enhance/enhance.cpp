@@ -2,6 +2,9 @@
 // and the provenance line.
 #include "vertexflow/enhance.h"
 
+#include "attributes/transport.h"
+#include "enhance/workable_faces.h"
+
 #include "vertexflow/enhance_options.h"
 #include "vertexflow/report_json.h"
 #include "vertexflow/timing.h"
@@ -9,6 +12,8 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <array>
 #include <utility>
 
 namespace vertexflow {
@@ -235,6 +240,7 @@ nlohmann::json flip_and_refit(const Mesh& input, const ReferenceSurface* referen
   const DistanceQuery& to_target = fit ? reference->distance_query() : *estimate;
   EdgeFlipOptions flips;
   flips.min_quality = o.guard.min_quality;
+  flips.fixed_edges = o.constraints.crease_edges;  // chart boundaries (enhance() sets them)
   // No face may end against the input face whose index it takes (faces_turned_over, the
   // report's flip count).
   Vertices slot_normals(input.F.rows(), 3);
@@ -358,9 +364,12 @@ void validate_enhance_options(const EnhanceOptions& options, bool has_reference,
   }
 }
 
-EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const EnhanceOptions& options,
-                      const EnhanceCallbacks& callbacks) {
-  validate_enhance_options(options, reference != nullptr, mesh.num_vertices());
+namespace {
+
+// The engine on a mesh whose faces all have three distinct vertices, positive area and no
+// duplicate, and whose vertices all have faces; attributes are left to enhance().
+EnhanceResult enhance_clean(const Mesh& mesh, const ReferenceSurface* reference, const EnhanceOptions& options,
+                            const EnhanceCallbacks& callbacks) {
   // Trees over the reference's faces this run builds (its own, or any step's copy): one is the
   // promise of reference_surface.h, the flow on S's own tree a second (flow.h).
   const std::uint64_t trees_before = reference ? distance_trees_built(reference->faces().rows()) : 0;
@@ -418,19 +427,10 @@ EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const
       break;
   }
 
-  // Same connectivity (unless edge flips) and colours; per-vertex properties of the input (say,
-  // curvature from an earlier run) no longer describe the moved vertices and are not carried.
+  // Same connectivity (unless edge flips); enhance() carries the attributes.
   Mesh& out = result.mesh;
   out.V = std::move(run.V);
   out.F = mesh.F;
-  out.colors = mesh.colors;
-  if (!mesh.vertex_properties.empty()) {
-    std::string names;
-    for (const VertexProperty& p : mesh.vertex_properties) names += (names.empty() ? "" : ", ") + p.name;
-    warn("vertex properties not carried: " + names +
-         " (they describe the input's vertices; re-sampling them where the vertices move is planned, "
-         "docs/attributes.md)");
-  }
   if (options.edge_flips)
     run.report["edge_flips"] =
         flip_and_refit(mesh, mode == EnhanceMode::ReferenceFit ? reference : nullptr, options, out, callbacks);
@@ -452,6 +452,142 @@ EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const
   run.report["method"] = enhance_mode_name(mode);
   if (reference) run.report["reference_trees_built"] = distance_trees_built(reference->faces().rows()) - trees_before;
   result.report = std::move(run.report);
+  return result;
+}
+
+}  // namespace
+
+namespace enhance_detail {
+
+std::vector<Index> workable_faces(const Mesh& mesh) {
+  const auto m = static_cast<std::size_t>(mesh.num_faces());
+  std::vector<char> out(m, 0);
+  for (const Index f : degenerate_faces(mesh.V, mesh.F)) out[static_cast<std::size_t>(f)] = 1;
+  // Repeats: faces sorted by their sorted corners; each but the first of a run is out.
+  std::vector<std::pair<std::array<Index, 3>, Index>> keys(m);
+  for (std::size_t f = 0; f < m; ++f) {
+    std::array<Index, 3> key{mesh.F(static_cast<Index>(f), 0), mesh.F(static_cast<Index>(f), 1),
+                             mesh.F(static_cast<Index>(f), 2)};
+    std::sort(key.begin(), key.end());
+    if (key[0] == key[1] || key[1] == key[2]) out[f] = 1;
+    keys[f] = {key, static_cast<Index>(f)};
+  }
+  std::sort(keys.begin(), keys.end());
+  for (std::size_t i = 1; i < m; ++i)
+    if (keys[i].first == keys[i - 1].first) out[static_cast<std::size_t>(keys[i].second)] = 1;
+  std::vector<Index> faces;
+  faces.reserve(m);
+  for (std::size_t f = 0; f < m; ++f)
+    if (!out[f]) faces.push_back(static_cast<Index>(f));
+  return faces;
+}
+
+Faces face_rows(const Faces& F, const std::vector<Index>& faces) {
+  Faces rows(static_cast<Eigen::Index>(faces.size()), 3);
+  for (std::size_t i = 0; i < faces.size(); ++i) rows.row(static_cast<Eigen::Index>(i)) = F.row(faces[i]);
+  return rows;
+}
+
+}  // namespace enhance_detail
+
+EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const EnhanceOptions& options,
+                      const EnhanceCallbacks& callbacks) {
+  validate_enhance_options(options, reference != nullptr, mesh.num_vertices());
+  try {
+    mesh.attributes.validate(mesh.num_vertices(), mesh.num_faces());
+  } catch (const std::invalid_argument& e) {
+    throw EnhanceOptionError(std::string("enhance: ") + e.what());
+  }
+  const Index n = mesh.num_vertices();
+  const std::vector<Index> faces = enhance_detail::workable_faces(mesh);
+  // Vertices of the faces kept out are held; vertices with no workable face are left out.
+  std::vector<Index> to_work(static_cast<std::size_t>(n), -1);
+  std::vector<char> held(static_cast<std::size_t>(n), 0);
+  for (Index f = 0; f < mesh.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k) held[static_cast<std::size_t>(mesh.F(f, k))] = 1;
+  for (const Index f : faces)
+    for (int k = 0; k < 3; ++k) to_work[static_cast<std::size_t>(mesh.F(f, k))] = 0;
+  std::vector<Index> to_input;
+  for (Index v = 0; v < n; ++v)
+    if (to_work[static_cast<std::size_t>(v)] == 0) {
+      to_work[static_cast<std::size_t>(v)] = static_cast<Index>(to_input.size());
+      to_input.push_back(v);
+    }
+  {
+    std::vector<char> in_workable(static_cast<std::size_t>(mesh.num_faces()), 0);
+    for (const Index f : faces) in_workable[static_cast<std::size_t>(f)] = 1;
+    std::fill(held.begin(), held.end(), 0);
+    for (Index f = 0; f < mesh.num_faces(); ++f)
+      if (!in_workable[static_cast<std::size_t>(f)])
+        for (int k = 0; k < 3; ++k) held[static_cast<std::size_t>(mesh.F(f, k))] = 1;
+  }
+  const bool whole = faces.size() == static_cast<std::size_t>(mesh.num_faces()) && to_input.size() == static_cast<std::size_t>(n);
+  if (whole && mesh.attributes.empty()) return enhance_clean(mesh, reference, options, callbacks);
+
+  // Chart boundaries (seams, material boundaries) are creases for the flow and never flipped.
+  const Faces workable_F = enhance_detail::face_rows(mesh.F, faces);
+  const Topology topology = build_topology(workable_F, n);
+  const std::vector<std::array<Index, 2>> seams = attributes_detail::chart_boundaries(mesh, faces, topology);
+
+  Mesh work;
+  work.comments = mesh.comments;
+  EnhanceOptions o = options;
+  o.constraints.pinned.clear();
+  o.constraints.crease_edges.clear();
+  work.V.resize(static_cast<Eigen::Index>(to_input.size()), 3);
+  for (std::size_t w = 0; w < to_input.size(); ++w) work.V.row(static_cast<Eigen::Index>(w)) = mesh.V.row(to_input[w]);
+  work.F.resize(workable_F.rows(), 3);
+  for (Eigen::Index i = 0; i < workable_F.rows(); ++i)
+    for (int k = 0; k < 3; ++k) work.F(i, k) = to_work[static_cast<std::size_t>(workable_F(i, k))];
+  for (const Index p : options.constraints.pinned)
+    if (to_work[static_cast<std::size_t>(p)] >= 0) o.constraints.pinned.push_back(to_work[static_cast<std::size_t>(p)]);
+  Index vertices_held = 0;
+  for (Index v = 0; v < n; ++v)
+    if (held[static_cast<std::size_t>(v)] && to_work[static_cast<std::size_t>(v)] >= 0) {
+      o.constraints.pinned.push_back(to_work[static_cast<std::size_t>(v)]);
+      ++vertices_held;
+    }
+  for (const auto& [a, b] : options.constraints.crease_edges)
+    if (a >= 0 && b >= 0 && a < n && b < n && to_work[static_cast<std::size_t>(a)] >= 0 &&
+        to_work[static_cast<std::size_t>(b)] >= 0)
+      o.constraints.crease_edges.push_back({to_work[static_cast<std::size_t>(a)], to_work[static_cast<std::size_t>(b)]});
+  for (const auto& [a, b] : seams)
+    o.constraints.crease_edges.push_back({to_work[static_cast<std::size_t>(a)], to_work[static_cast<std::size_t>(b)]});
+
+  EnhanceResult result = enhance_clean(work, reference, o, callbacks);
+  Mesh out;
+  out.V = mesh.V;
+  for (std::size_t w = 0; w < to_input.size(); ++w) out.V.row(to_input[w]) = result.mesh.V.row(static_cast<Eigen::Index>(w));
+  out.F = mesh.F;
+  for (std::size_t i = 0; i < faces.size(); ++i)
+    for (int k = 0; k < 3; ++k)
+      out.F(faces[i], k) = to_input[static_cast<std::size_t>(result.mesh.F(static_cast<Eigen::Index>(i), k))];
+  out.comments = std::move(result.mesh.comments);
+  const Index faces_held = mesh.num_faces() - static_cast<Index>(faces.size());
+  if (faces_held > 0) {
+    const std::string line = fmt::format(
+        "{} zero-area, repeated-vertex or duplicate faces stay in the face list; their {} vertices are held",
+        faces_held, vertices_held);
+    result.warnings.push_back(line);
+    if (callbacks.warning) callbacks.warning(line);
+  }
+  result.report["face_list"] = {{"faces", mesh.num_faces()},
+                                {"faces_held", faces_held},
+                                {"vertices_held", vertices_held},
+                                {"vertices_without_faces", n - static_cast<Index>(to_input.size())}};
+  if (!mesh.attributes.empty()) {
+    const auto start = Clock::now();
+    attributes_detail::TransportReport t;
+    out.attributes = attributes_detail::transport_attributes(mesh, faces, topology, out.V, out.F, t);
+    result.report["attributes"] = {{"chart_boundary_edges", seams.size()},
+                                   {"vertices_moved", t.vertices_moved},
+                                   {"wedges_located", t.wedges_located},
+                                   {"max_location_distance_edges", t.max_location_distance},
+                                   {"rows_added", t.rows_added},
+                                   {"normal_channels_recomputed", t.normal_channels},
+                                   {"seconds", seconds_since(start)}};
+  }
+  result.mesh = std::move(out);
   return result;
 }
 

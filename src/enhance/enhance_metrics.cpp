@@ -1,6 +1,7 @@
 // enhance_metrics (enhance.h): the figures of docs/metrics.md for an enhance result, as the
 // reports of `enhance --report`, `batch` and the Python module write them.
 #include "vertexflow/compare.h"
+#include "enhance/workable_faces.h"
 #include "vertexflow/curvature.h"
 #include "vertexflow/edge_flips.h"
 #include "vertexflow/enhance.h"
@@ -33,6 +34,17 @@ nlohmann::json distance_to(const Mesh& m, const ReferenceSurface& reference) {
 
 nlohmann::json enhance_metrics(const Mesh& input, const Mesh& result, const ReferenceSurface* reference,
                                EnhanceCurvatures* curvatures_out) {
+  // The faces enhance() held out (zero area, a repeated vertex, a duplicate) have no curvature,
+  // quality or orientation to measure: the metrics are those of the others, on the same vertices.
+  const std::vector<Index> faces = enhance_detail::workable_faces(input);
+  if (faces.size() != static_cast<std::size_t>(input.num_faces()) && result.F.rows() == input.F.rows()) {
+    Mesh input_part, result_part;
+    input_part.V = input.V;
+    input_part.F = enhance_detail::face_rows(input.F, faces);
+    result_part.V = result.V;
+    result_part.F = enhance_detail::face_rows(result.F, faces);
+    return enhance_metrics(input_part, result_part, reference, curvatures_out);
+  }
   const Topology topology = build_topology(input.F, input.num_vertices());
   // After edge flips the result has faces of its own (each keeping its index, edge_flips.h).
   const bool same_faces = result.F == input.F;

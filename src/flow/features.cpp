@@ -8,10 +8,27 @@
 
 namespace vertexflow {
 
-SurfaceFeatures detect_features(const Vertices& V, const Faces& F, const Topology& topology, double angle_degrees) {
+SurfaceFeatures detect_features(const Vertices& V, const Faces& F, const Topology& topology, double angle_degrees,
+                                const std::vector<std::array<Index, 2>>& crease_edges) {
   SurfaceFeatures features;
   const auto num_edges = static_cast<std::size_t>(topology.num_edges());
   features.sharp_edge.assign(num_edges, 0);
+  // Given creases (seams): interior edges only, found in the sorted edge list.
+  std::vector<char> given(crease_edges.empty() ? 0 : num_edges, 0);
+  for (const auto& [a, b] : crease_edges) {
+    const Index lo = std::min(a, b), hi = std::max(a, b);
+    Index first = 0, last = topology.num_edges();
+    while (first < last) {
+      const Index mid = first + (last - first) / 2;
+      if (topology.edges(mid, 0) < lo || (topology.edges(mid, 0) == lo && topology.edges(mid, 1) < hi))
+        first = mid + 1;
+      else
+        last = mid;
+    }
+    if (first < topology.num_edges() && topology.edges(first, 0) == lo && topology.edges(first, 1) == hi &&
+        topology.edge_face_count[static_cast<std::size_t>(first)] == 2)
+      given[static_cast<std::size_t>(first)] = features.sharp_edge[static_cast<std::size_t>(first)] = 1;
+  }
   features.vertex_sharp.assign(static_cast<std::size_t>(topology.num_vertices), {});
   const double cosine = std::cos(angle_degrees * M_PI / 180.0);
   if (angle_degrees < 180) {
@@ -54,7 +71,7 @@ SurfaceFeatures detect_features(const Vertices& V, const Faces& F, const Topolog
       if (features.sharp_edge[e]) ++edges_in[static_cast<std::size_t>(root(topology.edges(static_cast<Index>(e), 0)))];
     }
     for (std::size_t e = 0; e < num_edges; ++e) {
-      if (features.sharp_edge[e] &&
+      if (features.sharp_edge[e] && (given.empty() || !given[e]) &&
           edges_in[static_cast<std::size_t>(root(topology.edges(static_cast<Index>(e), 0)))] < kMinCreaseEdges)
         features.sharp_edge[e] = 0;
     }
@@ -90,8 +107,10 @@ SurfaceFeatures detect_features(const Vertices& V, const Faces& F, const Topolog
   for (Index f = 0; f < F.rows(); ++f) {
     for (int k = 0; k < 3; ++k) {
       const Index g = topology.face_adjacency(f, k);
-      if (g > f && features.face_patch[static_cast<std::size_t>(f)] == features.face_patch[static_cast<std::size_t>(g)])
-        features.sharp_edge[static_cast<std::size_t>(topology.face_edges(f, k))] = 0;
+      const auto e = static_cast<std::size_t>(topology.face_edges(f, k));
+      if (g > f && (given.empty() || !given[e]) &&
+          features.face_patch[static_cast<std::size_t>(f)] == features.face_patch[static_cast<std::size_t>(g)])
+        features.sharp_edge[e] = 0;
     }
   }
   for (std::size_t e = 0; e < num_edges; ++e) {

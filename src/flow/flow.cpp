@@ -73,6 +73,16 @@ FlowResult flow_on_manifold_split(const Vertices& V, const Faces& F, const Topol
       on_split.constraints.pinned.push_back(s);
   };
   for (const Index v : options.constraints.pinned) pin_copies(v);
+  // A crease between two vertices is one between every pair of their copies (pairs that are no
+  // edge of the split are ignored).
+  on_split.constraints.crease_edges.clear();
+  for (const auto& [a, b] : options.constraints.crease_edges) {
+    if (a < 0 || b < 0 || a >= static_cast<Index>(V.rows()) || b >= static_cast<Index>(V.rows())) continue;
+    for (Index s = split.first_copy[static_cast<std::size_t>(a)]; s < split.first_copy[static_cast<std::size_t>(a) + 1]; ++s)
+      for (Index t = split.first_copy[static_cast<std::size_t>(b)]; t < split.first_copy[static_cast<std::size_t>(b) + 1];
+           ++t)
+        on_split.constraints.crease_edges.push_back({s, t});
+  }
   for (Index v = 0; v < static_cast<Index>(V.rows()); ++v)
     if (split.held[static_cast<std::size_t>(v)]) pin_copies(v);
   FlowResult on_copies = check_then(split.V, split.F, build_topology(split.F, split.V.rows()), on_split, reference);

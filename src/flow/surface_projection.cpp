@@ -3,6 +3,7 @@
 // nearest-point question, the wrong one next to thin walls and creases.
 #include "surface_projection.h"
 
+#include "mesh/closest_point.h"
 #include "vertexflow/curvature.h"
 
 #include <tbb/blocked_range.h>
@@ -22,44 +23,14 @@ struct Candidate {
   double squared_distance = std::numeric_limits<double>::infinity();
 };
 
-// Closest point of face f to x; degenerate faces have no well-defined projection and are
-// never candidates (infinite distance). Written out (the region test of Ericson, Real-Time
-// Collision Detection, 5.1.5: which vertex, edge or interior region of the triangle x projects
-// into, from six dot products) rather than CGAL's Construct_projected_point_3 on a Triangle_3:
-// CGAL's builds the triangle, tests it for collinearity and projects through several
-// constructions, and was 42% of the time of the density passes (FlowOptions::density), which
-// project every vertex 30 times.
+// Closest point of face f to x (mesh/closest_point.h); degenerate faces have no well-defined
+// projection and are never candidates (infinite distance).
 Candidate closest_on_face(const Eigen::Vector3d& x, const Vertices& V, const Faces& F, Index f) {
   Candidate c;
-  const Eigen::Vector3d a = V.row(F(f, 0)), b = V.row(F(f, 1)), d = V.row(F(f, 2));
-  const Eigen::Vector3d ab = b - a, ad = d - a;
-  if (!(ab.cross(ad).squaredNorm() > 0)) return c;
+  const TrianglePoint t = closest_point_on_triangle(x, V.row(F(f, 0)), V.row(F(f, 1)), V.row(F(f, 2)));
+  if (!t.valid) return c;
   c.element = f;
-  const Eigen::Vector3d ax = x - a;
-  const double d1 = ab.dot(ax), d2 = ad.dot(ax);
-  if (d1 <= 0 && d2 <= 0) {
-    c.point = a;  // vertex region a
-  } else {
-    const Eigen::Vector3d bx = x - b;
-    const double d3 = ab.dot(bx), d4 = ad.dot(bx);
-    const Eigen::Vector3d dx = x - d;
-    const double d5 = ab.dot(dx), d6 = ad.dot(dx);
-    const double vc = d1 * d4 - d3 * d2, vb = d5 * d2 - d1 * d6, va = d3 * d6 - d5 * d4;
-    if (d3 >= 0 && d4 <= d3) {
-      c.point = b;  // vertex region b
-    } else if (vc <= 0 && d1 >= 0 && d3 <= 0) {
-      c.point = a + (d1 / (d1 - d3)) * ab;  // edge ab
-    } else if (d6 >= 0 && d5 <= d6) {
-      c.point = d;  // vertex region d
-    } else if (vb <= 0 && d2 >= 0 && d6 <= 0) {
-      c.point = a + (d2 / (d2 - d6)) * ad;  // edge ad
-    } else if (va <= 0 && (d4 - d3) >= 0 && (d5 - d6) >= 0) {
-      c.point = b + ((d4 - d3) / ((d4 - d3) + (d5 - d6))) * (d - b);  // edge bd
-    } else {
-      const double denominator = 1.0 / (va + vb + vc);  // interior: barycentric (va, vb, vc)
-      c.point = a + (vb * denominator) * ab + (vc * denominator) * ad;
-    }
-  }
+  c.point = t.point;
   c.squared_distance = (c.point - x).squaredNorm();
   return c;
 }

@@ -20,8 +20,12 @@ struct PolygonSoup {
   std::vector<double> xyz;                 // 3 per vertex
   std::vector<Index> corners;              // polygon corners, concatenated
   std::vector<std::int64_t> offsets{0};    // polygon p is corners[offsets[p], offsets[p+1])
-  std::vector<std::uint8_t> rgb;           // empty or 3 per vertex
-  std::vector<VertexProperty> properties;  // per-vertex scalars other than x, y, z, colours
+  std::vector<std::uint8_t> rgb;           // empty or 3 per vertex (OFF colours)
+  // Channels as the file has them: vertex channels one row per vertex, face channels one row
+  // per polygon, corner channels their own table, indexed by corner_rows.
+  MeshAttributes attributes;
+  // Per corner channel, the row each corner uses (-1 none), parallel to `corners`.
+  std::vector<std::vector<std::int32_t>> corner_rows;
   std::vector<std::string> comments;       // Mesh::comments, bounded by add_comment
   // What the file holds that the mesh does not keep, with counts (ReadReport::not_kept).
   std::vector<std::pair<std::string, std::int64_t>> not_kept;
@@ -49,6 +53,22 @@ struct PolygonSoup {
 
 /// Throws IoError("name: message").
 [[noreturn]] void fail(const std::string& name, const std::string& message);
+
+/// A channel of `columns.size()` components from per-component value columns of equal length.
+AttributeChannel make_channel(std::string name, std::vector<std::string> components, ScalarType type,
+                              AttributeRole role, const std::vector<std::vector<double>>& columns);
+
+/// How consecutive scalar properties of one element group into channels: "red green blue
+/// [alpha]" into a Color channel "color", "nx ny nz" into a Normal channel "normal", "s t",
+/// "u v", "texture_u texture_v" into a TexCoord channel "uv"; any other property is a channel
+/// of its own (role Label for integer types, Generic for floats). `names` and `types` are the
+/// element's scalar properties in file order; returns, per property, its channel's index and
+/// component, and the channels without values.
+struct ChannelLayout {
+  std::vector<AttributeChannel> channels;
+  std::vector<std::pair<int, int>> slot;  // per property: (channel, component)
+};
+ChannelLayout group_properties(const std::vector<std::string>& names, const std::vector<ScalarType>& types);
 
 /// Adds the comment whose text (after the marker) starts `line` to `comments`, as io.h says:
 /// cut at the first newline and to kMaxCommentBytes, blanks trimmed, control characters

@@ -224,11 +224,22 @@ Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& repor
   const Index nv = static_cast<Index>(soup.num_vertices());
 
   // Triangulate, dropping faces with fewer than three distinct vertices. A file of triangles
-  // only (the common case) hands its corner list over as it is.
+  // only (the common case) hands its corner list over as it is. Where faces carry data (face
+  // and corner channels), each triangle's polygon and corners are tracked so that it takes
+  // theirs; a file of triangles only needs no tracking (triangle t is polygon t).
+  for (auto& rows : soup.corner_rows) rows.resize(soup.corners.size(), -1);
+  const bool track = !soup.attributes.corner.empty() || !soup.attributes.face.empty();
   std::vector<Index> tris;
   std::vector<Index> polygon;
+  std::vector<std::int64_t> polygon_corner;  // soup corner of each entry of `polygon`
+  std::vector<std::int64_t> tri_corner, tri_polygon;  // per triangle corner, per triangle
   EdgeSet edges;  // filled only when the file has polygons
   const bool has_polygons = soup.corners.size() != 3 * static_cast<std::size_t>(soup.num_polygons());
+  const bool tracked = track && has_polygons;
+  auto source_of = [&](std::size_t t) { return tracked ? tri_polygon[t] : static_cast<std::int64_t>(t); };
+  auto corner_of = [&](std::size_t t, int k) {
+    return tracked ? tri_corner[3 * t + static_cast<std::size_t>(k)] : static_cast<std::int64_t>(3 * t) + k;
+  };
   if (!has_polygons) {
     tris = std::move(soup.corners);
     soup.offsets = {0};  // nothing left for the polygon loop below
@@ -241,46 +252,56 @@ Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& repor
                               soup.corners[static_cast<std::size_t>(c + 1 < end ? c + 1 : begin)]));
     }
   }
+  // Records the source of the triangles appended to `tris` since `first` (a multiple of 3).
+  auto track_new = [&](std::size_t first, std::int64_t p) {
+    if (!tracked) return;
+    for (std::size_t i = first; i < tris.size(); ++i) {
+      std::size_t at = 0;
+      while (at + 1 < polygon.size() && polygon[at] != tris[i]) ++at;
+      tri_corner.push_back(polygon_corner[at]);
+    }
+    tri_polygon.resize(tris.size() / 3, p);
+  };
   for (std::int64_t p = 0; p < soup.num_polygons(); ++p) {
-    const Index* c = soup.corners.data() + soup.offsets[static_cast<std::size_t>(p)];
-    const std::size_t n = static_cast<std::size_t>(soup.offsets[static_cast<std::size_t>(p) + 1] -
-                                                   soup.offsets[static_cast<std::size_t>(p)]);
+    const std::int64_t first_corner = soup.offsets[static_cast<std::size_t>(p)];
+    const Index* c = soup.corners.data() + first_corner;
+    const std::size_t n = static_cast<std::size_t>(soup.offsets[static_cast<std::size_t>(p) + 1] - first_corner);
+    polygon.clear();
+    polygon_corner.clear();
     if (n == 3) {  // repeated indices are removed with the others after this loop
       tris.insert(tris.end(), c, c + 3);
+      if (tracked) {
+        for (int k = 0; k < 3; ++k) tri_corner.push_back(first_corner + k);
+        tri_polygon.resize(tris.size() / 3, p);
+      }
       continue;
     }
     // Polygon: drop consecutive repeats (including last == first) before triangulating.
-    polygon.clear();
     for (std::size_t i = 0; i < n; ++i) {
-      if (polygon.empty() || polygon.back() != c[i]) polygon.push_back(c[i]);
+      if (polygon.empty() || polygon.back() != c[i]) {
+        polygon.push_back(c[i]);
+        polygon_corner.push_back(first_corner + static_cast<std::int64_t>(i));
+      }
     }
-    while (polygon.size() > 1 && polygon.back() == polygon.front()) polygon.pop_back();
+    while (polygon.size() > 1 && polygon.back() == polygon.front()) {
+      polygon.pop_back();
+      polygon_corner.pop_back();
+    }
     std::vector<Index> distinct = polygon;
     std::sort(distinct.begin(), distinct.end());
     if (std::unique(distinct.begin(), distinct.end()) - distinct.begin() < 3) {
       ++report.repeated_index_faces_removed;
       continue;
     }
+    const std::size_t first = tris.size();
     if (polygon.size() == 3) {
       tris.insert(tris.end(), polygon.begin(), polygon.end());
+      track_new(first, p);
       continue;
     }
     ++report.polygons_triangulated;
     if (!triangulate_polygon(soup.xyz.data(), polygon.data(), polygon.size(), edges, tris)) ++report.polygons_fanned;
-  }
-  // Fanning a polygon with a repeated corner can create triangles with a repeated index.
-  {
-    std::size_t out = 0;
-    for (std::size_t f = 0; f < tris.size() / 3; ++f) {
-      const Index a = tris[3 * f], b = tris[3 * f + 1], c = tris[3 * f + 2];
-      if (a == b || b == c || c == a) {
-        ++report.repeated_index_faces_removed;
-        continue;
-      }
-      tris[3 * out] = a, tris[3 * out + 1] = b, tris[3 * out + 2] = c;
-      ++out;
-    }
-    tris.resize(3 * out);
+    track_new(first, p);
   }
 
   Mesh mesh;
@@ -297,10 +318,19 @@ Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& repor
                            kMinDiagonal, kMaxDiagonal));
   const double min_area = kDegenerateAreaRelative * diagonal * diagonal;
 
+  // Faces with a repeated index (fanning a polygon with a repeated corner makes them too),
+  // duplicates and zero-area faces are removed, or with keep_face_list counted and kept.
+  const bool keep = options.keep_face_list;
+  const std::size_t num_tris = tris.size() / 3;
+  std::vector<char> repeated(num_tris, 0);
+  for (std::size_t f = 0; f < num_tris; ++f) {
+    const Index a = tris[3 * f], b = tris[3 * f + 1], c = tris[3 * f + 2];
+    repeated[f] = a == b || b == c || c == a;
+  }
   const std::vector<char> duplicate = find_duplicate_faces(tris, nv);
-  std::vector<char> zero_area(tris.size() / 3, 0);
-  if (options.remove_zero_area_faces) {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, tris.size() / 3, 16384), [&](const auto& range) {
+  std::vector<char> zero_area(num_tris, 0);
+  if (options.remove_zero_area_faces || keep) {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, num_tris, 16384), [&](const auto& range) {
       for (std::size_t f = range.begin(); f != range.end(); ++f) {
         const Eigen::Vector3d a = mesh.V.row(tris[3 * f]);
         const Eigen::Vector3d b = mesh.V.row(tris[3 * f + 1]);
@@ -309,25 +339,65 @@ Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& repor
       }
     });
   }
+  std::vector<std::int64_t> kept_source;  // the triangle each kept face was, when tracking
   std::size_t kept = 0;
-  for (std::size_t f = 0; f < tris.size() / 3; ++f) {
-    if (duplicate[f]) {
+  for (std::size_t f = 0; f < num_tris; ++f) {
+    if (keep) {
+      if (repeated[f] || zero_area[f])
+        ++report.degenerate_faces_kept;
+      else if (duplicate[f])
+        ++report.duplicate_faces_kept;
+    } else if (repeated[f]) {
+      ++report.repeated_index_faces_removed;
+      continue;
+    } else if (duplicate[f]) {
       ++report.duplicate_faces_removed;
       continue;
-    }
-    if (zero_area[f]) {
+    } else if (zero_area[f]) {
       ++report.zero_area_faces_removed;
       continue;
     }
     for (int k = 0; k < 3; ++k)
       tris[3 * kept + static_cast<std::size_t>(k)] = tris[3 * f + static_cast<std::size_t>(k)];
+    if (track) kept_source.push_back(static_cast<std::int64_t>(f));
     ++kept;
   }
   if (kept == 0) fail(name, "no valid faces remain (all faces are degenerate or repeated)");
   mesh.F = Eigen::Map<const Faces>(tris.data(), static_cast<Eigen::Index>(kept), 3);
 
-  if (!soup.rgb.empty()) mesh.colors = Eigen::Map<const Colors>(soup.rgb.data(), nv, 3);
-  mesh.vertex_properties = std::move(soup.properties);
+  // Channels follow the faces kept: a face row per face from its polygon, corner rows from
+  // its corners.
+  MeshAttributes& attributes = mesh.attributes;
+  attributes = std::move(soup.attributes);
+  for (AttributeChannel& channel : attributes.face) {
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rows(static_cast<Eigen::Index>(kept),
+                                                                                 channel.width());
+    for (std::size_t f = 0; f < kept; ++f) {
+      const std::int64_t p = source_of(static_cast<std::size_t>(kept_source[f]));
+      if (p < channel.rows())
+        rows.row(static_cast<Eigen::Index>(f)) = channel.values.row(static_cast<Eigen::Index>(p));
+      else
+        rows.row(static_cast<Eigen::Index>(f)).setZero();  // a strip's triangle: the element had no row
+    }
+    channel.values = std::move(rows);
+  }
+  for (std::size_t c = 0; c < attributes.corner.size(); ++c) {
+    CornerChannel& channel = attributes.corner[c];
+    channel.corners.resize(static_cast<Eigen::Index>(kept), 3);
+    for (std::size_t f = 0; f < kept; ++f)
+      for (int k = 0; k < 3; ++k)
+        channel.corners(static_cast<Eigen::Index>(f), k) =
+            soup.corner_rows[c][static_cast<std::size_t>(corner_of(static_cast<std::size_t>(kept_source[f]), k))];
+  }
+  if (!soup.rgb.empty()) {
+    AttributeChannel& color = attributes.vertex.emplace_back();
+    color.name = "color";
+    color.components = {"red", "green", "blue"};
+    color.type = ScalarType::UInt8;
+    color.role = AttributeRole::Color;
+    color.values = Eigen::Map<const Eigen::Matrix<std::uint8_t, Eigen::Dynamic, 3, Eigen::RowMajor>>(soup.rgb.data(), nv, 3)
+                       .cast<double>();
+  }
   mesh.comments = std::move(soup.comments);
   for (const auto& [what, count] : soup.not_kept) report.not_kept.push_back(fmt::format("{} ({})", what, count));
 
@@ -338,7 +408,9 @@ Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& repor
   for (auto& v : new_index) {
     if (v == 0) v = used++;
   }
-  if (used < nv) {
+  if (used < nv && keep) {
+    report.unreferenced_vertices_kept += nv - used;
+  } else if (used < nv) {
     report.unreferenced_vertices_removed += nv - used;
     auto compact_rows = [&](auto& matrix) {
       for (Index v = 0; v < nv; ++v) {
@@ -348,14 +420,7 @@ Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& repor
       matrix.conservativeResize(used, Eigen::NoChange);
     };
     compact_rows(mesh.V);
-    if (mesh.colors.rows() > 0) compact_rows(mesh.colors);
-    for (auto& property : mesh.vertex_properties) {
-      for (Index v = 0; v < nv; ++v) {
-        if (new_index[static_cast<std::size_t>(v)] >= 0)
-          property.values[new_index[static_cast<std::size_t>(v)]] = property.values[v];
-      }
-      property.values.conservativeResize(used);
-    }
+    for (AttributeChannel& channel : attributes.vertex) compact_rows(channel.values);
     for (Eigen::Index i = 0; i < mesh.F.size(); ++i)
       mesh.F.data()[i] = new_index[static_cast<std::size_t>(mesh.F.data()[i])];
   }
@@ -421,10 +486,13 @@ std::vector<std::string> ReadReport::warnings() const {
   add(duplicate_faces_removed, "duplicate faces removed");
   add(zero_area_faces_removed, "zero-area faces removed");
   add(strip_triangles, "triangles read from triangle strips");
+  add(degenerate_faces_kept, "zero-area faces or faces with a repeated vertex kept (their vertices are held)");
+  add(duplicate_faces_kept, "duplicate faces kept (their vertices are held)");
+  add(unreferenced_vertices_kept, "unreferenced vertices kept (held)");
   if (!not_kept.empty()) {
     std::string list;
     for (const std::string& item : not_kept) list += (list.empty() ? "" : ", ") + item;
-    out.push_back("not kept (the output has positions, faces, vertex colours and comments only): " + list);
+    out.push_back("not kept: " + list);
   }
   return out;
 }

@@ -13,7 +13,7 @@
 namespace vertexflow::io_detail {
 namespace {
 
-enum class Type { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64 };
+using Type = ScalarType;  // PLY's eight types are the attribute model's (attributes.h)
 
 std::optional<Type> parse_type(std::string_view s) {
   if (s == "char" || s == "int8") return Type::Int8;
@@ -90,7 +90,7 @@ struct Element {
 enum class Encoding { Ascii, BinaryLittle, BinaryBig };
 
 // What each vertex property becomes.
-enum class Role { X, Y, Z, Red, Green, Blue, Scalar, Skip };
+enum class Role { X, Y, Z, Channel, Skip };
 
 class PlyParser {
  public:
@@ -319,47 +319,84 @@ class PlyParser {
     return *scanner_;
   }
 
+  // A property value to be stored in a channel: exactly what its type holds. ASCII text can
+  // hold any number, so an integer property's value must be one its type holds (converting a
+  // double outside 0..255, or NaN, to uint8 would be undefined behaviour: found by
+  // fuzz_read_ply).
+  double channel_value(const Property& p, const char* what) {
+    const double value = next_value(p.type, what);
+    if (encoding_ != Encoding::Ascii) return value;
+    if (is_integer(p.type) && to_scalar_type(value, p.type) != value)
+      ascii().error(fmt::format("{} '{}' value {} is not a {}", what, p.name, value, scalar_type_name(p.type)));
+    return to_scalar_type(value, p.type);
+  }
+
+  // The scalar properties of `element` other than `excluded` as channels (group_properties),
+  // with a column of values per property (`columns`) and each property's slot in them (-1 for
+  // properties that are no channel).
+  ChannelLayout element_channels(const Element& element, const std::vector<char>& excluded,
+                                 std::vector<int>& column_of) {
+    std::vector<std::string> names;
+    std::vector<ScalarType> types;
+    column_of.assign(element.properties.size(), -1);
+    for (std::size_t i = 0; i < element.properties.size(); ++i) {
+      const Property& p = element.properties[i];
+      if (p.is_list || excluded[i]) continue;
+      column_of[i] = static_cast<int>(names.size());
+      names.push_back(p.name);
+      types.push_back(p.type);
+    }
+    return group_properties(names, types);
+  }
+
+  // Moves per-property columns into the layout's channels.
+  static void fill_channels(ChannelLayout& layout, std::vector<std::vector<double>>& columns,
+                            std::vector<AttributeChannel>& out) {
+    std::vector<std::vector<std::vector<double>>> per_channel(layout.channels.size());
+    for (std::size_t c = 0; c < layout.channels.size(); ++c) per_channel[c].resize(layout.channels[c].components.size());
+    for (std::size_t i = 0; i < columns.size(); ++i) {
+      const auto [channel, component] = layout.slot[i];
+      per_channel[static_cast<std::size_t>(channel)][static_cast<std::size_t>(component)] = std::move(columns[i]);
+    }
+    for (std::size_t c = 0; c < layout.channels.size(); ++c) {
+      AttributeChannel& channel = layout.channels[c];
+      out.push_back(make_channel(std::move(channel.name), std::move(channel.components), channel.type, channel.role,
+                                 per_channel[c]));
+    }
+  }
+
   void read_vertices(const Element& element) {
     check_count(element);
     std::vector<Role> roles;
-    std::vector<std::size_t> scalar_slot;
+    std::vector<char> coordinate(element.properties.size(), 0);
     bool has[3] = {false, false, false};
-    int color_channels = 0;
-    for (const Property& p : element.properties) {
-      Role role = Role::Skip;
+    for (std::size_t i = 0; i < element.properties.size(); ++i) {
+      const Property& p = element.properties[i];
+      Role role = p.is_list ? Role::Skip : Role::Channel;
       if (!p.is_list) {
-        if (p.name == "x")
-          role = Role::X, has[0] = true;
-        else if (p.name == "y")
-          role = Role::Y, has[1] = true;
-        else if (p.name == "z")
-          role = Role::Z, has[2] = true;
-        else if (p.type == Type::UInt8 && (p.name == "red" || p.name == "green" || p.name == "blue")) {
-          role = p.name == "red" ? Role::Red : p.name == "green" ? Role::Green : Role::Blue;
-          ++color_channels;
-        } else if (p.type != Type::UInt8 || p.name != "alpha") {
-          role = Role::Scalar;
-        }
+        for (int axis = 0; axis < 3; ++axis)
+          if (p.name == "xyz"[axis] + std::string() && !has[axis]) {
+            role = static_cast<Role>(axis);
+            has[axis] = true;
+            coordinate[i] = 1;
+          }
       }
       roles.push_back(role);
     }
     if (!has[0] || !has[1] || !has[2]) fail(name_, "vertex element lacks an x, y or z property");
+    std::vector<int> column_of;
+    ChannelLayout layout = element_channels(element, coordinate, column_of);
     // The count is bounded by the bytes the input can hold (check_count; for gzip, by the
     // inflation limit). Reserved pages become resident only as records fill them, so a gzip
     // header's claim costs address space, not memory, until the content backs it.
     const std::uint64_t n = element.count;
     const auto expected = static_cast<std::size_t>(n);
     soup_.xyz.reserve(3 * expected);
-    if (color_channels == 3) soup_.rgb.reserve(3 * expected);
-    std::vector<std::vector<double>> scalars;
-    for (std::size_t i = 0; i < element.properties.size(); ++i) {
-      scalar_slot.push_back(scalars.size());
-      if (roles[i] == Role::Scalar) scalars.emplace_back().reserve(expected);
-    }
+    std::vector<std::vector<double>> columns(layout.slot.size());
+    for (auto& column : columns) column.reserve(expected);
     for (std::uint64_t v = 0; v < n; ++v) {
       begin_record();
       double xyz[3] = {0, 0, 0};
-      std::uint8_t rgb[3] = {0, 0, 0};
       for (std::size_t i = 0; i < element.properties.size(); ++i) {
         const Property& p = element.properties[i];
         switch (roles[i]) {
@@ -368,19 +405,8 @@ class PlyParser {
           case Role::Z:
             xyz[static_cast<std::size_t>(roles[i])] = next_value(p.type, "a vertex coordinate");
             break;
-          case Role::Red:
-          case Role::Green:
-          case Role::Blue: {
-            const double c = next_value(p.type, "a vertex colour");
-            // Declared uchar, but ASCII text can hold any number, and converting a double
-            // outside 0..255 (or NaN) to uint8 is undefined behaviour. (Found by fuzz_read_ply.)
-            if (encoding_ == Encoding::Ascii && !(c >= 0 && c <= 255))
-              ascii().error(fmt::format("vertex colour {} is outside 0..255", c));
-            rgb[static_cast<std::size_t>(roles[i]) - 3] = static_cast<std::uint8_t>(c);
-            break;
-          }
-          case Role::Scalar:
-            scalars[scalar_slot[i]].push_back(next_value(p.type, "a vertex property"));
+          case Role::Channel:
+            columns[static_cast<std::size_t>(column_of[i])].push_back(channel_value(p, "vertex property"));
             break;
           case Role::Skip:
             skip_property(p);
@@ -388,30 +414,32 @@ class PlyParser {
         }
       }
       soup_.add_vertex(xyz[0], xyz[1], xyz[2]);
-      if (color_channels == 3) soup_.rgb.insert(soup_.rgb.end(), rgb, rgb + 3);
       end_record(element);
     }
-    for (std::size_t i = 0; i < element.properties.size(); ++i) {
+    for (std::size_t i = 0; i < element.properties.size(); ++i)
       if (roles[i] == Role::Skip && n > 0)
-        soup_.count_not_kept("PLY vertex property '" + element.properties[i].name + "'", static_cast<std::int64_t>(n));
-      if (roles[i] != Role::Scalar) continue;
-      const std::vector<double>& values = scalars[scalar_slot[i]];
-      soup_.properties.push_back(
-          {element.properties[i].name,
-           Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()))});
-    }
+        soup_.count_not_kept("PLY vertex list property '" + element.properties[i].name + "'",
+                             static_cast<std::int64_t>(n));
+    fill_channels(layout, columns, soup_.attributes.vertex);
     sync_ascii();
   }
 
   // A `face` element (one polygon per record), or a `tristrips` element (Cyberware and Stanford
   // scans: one or more strips per record, separated by -1; triangle i of a strip is corners
-  // (i, i+1, i+2), every other one turned round to keep the strip's orientation).
+  // (i, i+1, i+2), every other one turned round to keep the strip's orientation). A face
+  // element's scalar properties become face channels, and a float list `texcoord` (MeshLab's
+  // per-corner texture coordinates, two per corner) a corner channel.
   void read_faces(const Element& element, bool strips) {
     check_count(element);
     std::size_t index_property = element.properties.size();
+    std::size_t texcoord_property = element.properties.size();
     for (std::size_t i = 0; i < element.properties.size(); ++i) {
       const Property& p = element.properties[i];
-      if (p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index")) index_property = i;
+      if (p.is_list && (p.name == "vertex_indices" || p.name == "vertex_index") &&
+          index_property == element.properties.size())
+        index_property = i;
+      else if (!strips && p.is_list && p.name == "texcoord" && !is_integer(p.type))
+        texcoord_property = i;
     }
     if (index_property == element.properties.size())
       fail(name_, element.name + " element has no 'vertex_indices' list property");
@@ -423,11 +451,32 @@ class PlyParser {
       soup_.offsets.reserve(expected + 1);
       soup_.corners.reserve(3 * expected);
     }
+    // Strips carry no face data we keep: their triangles are not the element's records.
+    std::vector<char> excluded(element.properties.size(), strips ? 1 : 0);
+    excluded[index_property] = 1;
+    std::vector<int> column_of;
+    ChannelLayout layout = element_channels(element, excluded, column_of);
+    std::vector<std::vector<double>> columns(layout.slot.size());
+    for (auto& column : columns) column.reserve(expected);
+    std::vector<double> texcoords;  // two per corner
     std::vector<Index> strip;
+    const std::size_t first_polygon = static_cast<std::size_t>(soup_.num_polygons());
     for (std::uint64_t f = 0; f < n; ++f) {
       begin_record();
+      std::size_t polygon_corners = 0, polygon_texcoords = 0;
       for (std::size_t i = 0; i < element.properties.size(); ++i) {
         const Property& p = element.properties[i];
+        if (column_of[i] >= 0) {
+          columns[static_cast<std::size_t>(column_of[i])].push_back(channel_value(p, "face property"));
+          continue;
+        }
+        if (i == texcoord_property) {
+          const std::uint64_t count = next_list_count(p);
+          for (std::uint64_t k = 0; k < count; ++k)
+            texcoords.push_back(to_scalar_type(next_value(p.type, "a texture coordinate"), p.type));
+          polygon_texcoords = static_cast<std::size_t>(count);
+          continue;
+        }
         if (i != index_property) {
           skip_property(p);
           continue;
@@ -448,15 +497,48 @@ class PlyParser {
           else
             soup_.corners.push_back(static_cast<Index>(index));
         }
+        polygon_corners = static_cast<std::size_t>(count);
         if (strips) end_strip(strip);
       }
+      if (texcoord_property < element.properties.size() && polygon_texcoords != 2 * polygon_corners)
+        fail(name_, fmt::format("face {} has {} texcoord values for {} corners (expected two per corner)", f,
+                                polygon_texcoords, polygon_corners));
       if (!strips) soup_.end_polygon();
       end_record(element);
     }
     for (std::size_t i = 0; i < element.properties.size(); ++i)
-      if (i != index_property && n > 0)
+      if (i != index_property && i != texcoord_property && column_of[i] < 0 && n > 0)
         soup_.count_not_kept("PLY " + element.name + " property '" + element.properties[i].name + "'",
                              static_cast<std::int64_t>(n));
+    if (!strips) {
+      // Face channels have a row per polygon of the soup; polygons read before this element
+      // (a file with two face elements) get zeros.
+      std::vector<AttributeChannel> channels;
+      fill_channels(layout, columns, channels);
+      for (AttributeChannel& channel : channels) {
+        if (first_polygon > 0) {
+          Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> padded =
+              Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(first_polygon) + channel.rows(), channel.width());
+          padded.bottomRows(channel.rows()) = channel.values;
+          channel.values = std::move(padded);
+        }
+        soup_.attributes.face.push_back(std::move(channel));
+      }
+      if (texcoord_property < element.properties.size()) {
+        const Property& p = element.properties[texcoord_property];
+        CornerChannel& corner = soup_.attributes.corner.emplace_back();
+        corner.channel.name = p.name;
+        corner.channel.components = {"u", "v"};
+        corner.channel.type = p.type;
+        corner.channel.role = AttributeRole::TexCoord;
+        corner.channel.values = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, 2, Eigen::RowMajor>>(
+            texcoords.data(), static_cast<Eigen::Index>(texcoords.size() / 2), 2);
+        // Corner c of this element's polygons uses row c; earlier polygons' corners have none.
+        std::vector<std::int32_t>& rows = soup_.corner_rows.emplace_back(soup_.corners.size(), -1);
+        const std::size_t first_corner = soup_.corners.size() - texcoords.size() / 2;
+        for (std::size_t c = first_corner; c < rows.size(); ++c) rows[c] = static_cast<std::int32_t>(c - first_corner);
+      }
+    }
     sync_ascii();
   }
 

@@ -7,6 +7,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+#include <limits>
+
 #include <fcntl.h>
 #include <pthread.h>
 #include <sys/stat.h>
@@ -369,38 +372,208 @@ void append_comments(std::string& b, std::string_view prefix, const Mesh& mesh) 
   }
 }
 
-bool has_colors(const Mesh& mesh, const WriteOptions& options) {
-  return options.write_colors && mesh.colors.rows() == mesh.V.rows() && mesh.colors.rows() > 0;
+// The channels each format writes (attributes_not_written names the rest).
+struct Written {
+  std::vector<const AttributeChannel*> vertex, face;
+  const CornerChannel* corner_uv = nullptr;
+  const CornerChannel* corner_normal = nullptr;
+  const AttributeChannel* vertex_uv = nullptr;      // OBJ: vt per vertex
+  const AttributeChannel* vertex_normal = nullptr;  // OBJ: vn per vertex
+  const AttributeChannel* color = nullptr;          // OFF
+  bool names = false;                               // OBJ's material, group, object names
+};
+
+bool is_obj_label(const AttributeChannel& c) {
+  return c.width() == 1 && (c.name == "material" || c.name == "group" || c.name == "object" || c.name == "smoothing");
 }
 
-void write_obj(Output& out, const Mesh& mesh) {
+Written written_channels(const Mesh& mesh, MeshFormat format, const WriteOptions& options) {
+  Written w;
+  const MeshAttributes& a = mesh.attributes;
+  auto vertex_wanted = [&](const AttributeChannel& c) {
+    return c.role == AttributeRole::Color ? options.write_colors : options.write_vertex_properties;
+  };
+  auto first_corner = [&](AttributeRole role) -> const CornerChannel* {
+    if (!options.write_attributes) return nullptr;
+    for (const CornerChannel& c : a.corner)
+      if (c.channel.role == role && c.corners.rows() == mesh.F.rows()) return &c;
+    return nullptr;
+  };
+  switch (format) {
+    case MeshFormat::Ply:
+      for (const AttributeChannel& c : a.vertex)
+        if (vertex_wanted(c)) w.vertex.push_back(&c);
+      if (options.write_attributes)
+        for (const AttributeChannel& c : a.face)
+          if (c.rows() == mesh.F.rows()) w.face.push_back(&c);
+      w.corner_uv = first_corner(AttributeRole::TexCoord);
+      if (w.corner_uv && w.corner_uv->channel.width() != 2) w.corner_uv = nullptr;
+      break;
+    case MeshFormat::Obj:
+      w.corner_uv = first_corner(AttributeRole::TexCoord);
+      w.corner_normal = first_corner(AttributeRole::Normal);
+      for (const AttributeChannel& c : a.vertex) {
+        if (!vertex_wanted(c)) continue;
+        if (!w.corner_uv && !w.vertex_uv && c.role == AttributeRole::TexCoord && c.width() <= 3) w.vertex_uv = &c;
+        if (!w.corner_normal && !w.vertex_normal && c.role == AttributeRole::Normal && c.width() == 3)
+          w.vertex_normal = &c;
+      }
+      if (options.write_attributes)
+        for (const AttributeChannel& c : a.face)
+          if (c.rows() == mesh.F.rows() && is_obj_label(c)) w.face.push_back(&c);
+      w.names = options.write_attributes;
+      break;
+    case MeshFormat::Off:
+      for (const AttributeChannel& c : a.vertex)
+        if (!w.color && c.role == AttributeRole::Color && c.width() >= 3 && vertex_wanted(c)) w.color = &c;
+      break;
+    case MeshFormat::Stl:
+      break;
+  }
+  return w;
+}
+
+// A channel's value as the file stores it: ASCII text of its type.
+void append_value(std::string& b, double value, ScalarType type) {
+  if (is_integer_type(type)) {
+    append_int(b, static_cast<std::int64_t>(to_scalar_type(value, type)));
+  } else if (type == ScalarType::Float32) {
+    char buffer[32];
+    const auto result = std::to_chars(buffer, buffer + sizeof(buffer), static_cast<float>(value));
+    b.append(buffer, result.ptr);
+  } else {
+    append_double(b, value);
+  }
+}
+
+void store_value(std::string& b, double value, ScalarType type, bool swap) {
+  const double v = to_scalar_type(value, type);
+  switch (type) {
+    case ScalarType::Int8:
+      return store_scalar<std::int8_t>(b, static_cast<std::int8_t>(v), swap);
+    case ScalarType::UInt8:
+      return store_scalar<std::uint8_t>(b, static_cast<std::uint8_t>(v), swap);
+    case ScalarType::Int16:
+      return store_scalar<std::int16_t>(b, static_cast<std::int16_t>(v), swap);
+    case ScalarType::UInt16:
+      return store_scalar<std::uint16_t>(b, static_cast<std::uint16_t>(v), swap);
+    case ScalarType::Int32:
+      return store_scalar<std::int32_t>(b, static_cast<std::int32_t>(v), swap);
+    case ScalarType::UInt32:
+      return store_scalar<std::uint32_t>(b, static_cast<std::uint32_t>(v), swap);
+    case ScalarType::Float32:
+      return store_scalar<float>(b, static_cast<float>(v), swap);
+    case ScalarType::Float64:
+      return store_scalar<double>(b, v, swap);
+  }
+}
+
+const char* ply_type_name(ScalarType type) {
+  static constexpr const char* names[] = {"char", "uchar", "short", "ushort", "int", "uint", "float", "double"};
+  return names[static_cast<int>(type)];
+}
+
+// OBJ: the channel's rows as `PREFIX a b c` lines.
+void append_rows(Output& out, const char* prefix, const AttributeChannel& channel) {
+  std::string& b = out.buffer();
+  for (Eigen::Index r = 0; r < channel.rows(); ++r) {
+    b += prefix;
+    for (int k = 0; k < channel.width(); ++k) {
+      b += ' ';
+      append_double(b, channel.values(r, k));
+    }
+    b += '\n';
+    out.maybe_flush();
+  }
+}
+
+void write_obj(Output& out, const Mesh& mesh, const WriteOptions& options) {
+  const Written w = written_channels(mesh, MeshFormat::Obj, options);
+  const MeshAttributes& a = mesh.attributes;
   std::string& b = out.buffer();
   b += "# written by vertexflow\n";
   append_comments(b, "# ", mesh);
+  if (w.names)
+    for (const std::string& library : a.material_libraries) b += "mtllib " + library + "\n";
   for (Index v = 0; v < mesh.num_vertices(); ++v) {
     append_position(b, "v ", mesh, v);
     b += '\n';
     out.maybe_flush();
   }
+  const AttributeChannel* uv = w.corner_uv ? &w.corner_uv->channel : w.vertex_uv;
+  const AttributeChannel* normal = w.corner_normal ? &w.corner_normal->channel : w.vertex_normal;
+  if (uv) append_rows(out, "vt", *uv);
+  if (normal) append_rows(out, "vn", *normal);
+  // Labels are written where they change, in OBJ's order: object, group, material, smoothing.
+  struct Label {
+    const AttributeChannel* channel = nullptr;
+    const std::vector<std::string>* names = nullptr;
+    const char* keyword = "";
+    double last = std::numeric_limits<double>::quiet_NaN();
+  };
+  std::vector<Label> labels;
+  for (const char* name : {"object", "group", "material", "smoothing"}) {
+    for (const AttributeChannel* c : w.face) {
+      if (c->name != name) continue;
+      Label label;
+      label.channel = c;
+      label.keyword = c->name == "object" ? "o" : c->name == "group" ? "g" : c->name == "material" ? "usemtl" : "s";
+      label.names = c->name == "object" ? &a.objects : c->name == "group" ? &a.groups : c->name == "material" ? &a.materials : nullptr;
+      labels.push_back(label);
+    }
+  }
+  auto corner_row = [&](const CornerChannel* corner, const AttributeChannel* per_vertex, Index f, int k) -> std::int64_t {
+    if (corner) return corner->corners(f, k);
+    return per_vertex ? mesh.F(f, k) : -1;
+  };
   for (Index f = 0; f < mesh.num_faces(); ++f) {
-    append_face(b, "f ", mesh, f, 1);
+    for (Label& label : labels) {
+      const double value = label.channel->values(f, 0);
+      if (value == label.last) continue;
+      label.last = value;
+      const auto index = static_cast<std::int64_t>(value);
+      if (label.names == nullptr) {
+        b += index == 0 ? "s off\n" : fmt::format("s {}\n", index);
+      } else if (index >= 0 && index < static_cast<std::int64_t>(label.names->size())) {
+        b += fmt::format("{} {}\n", label.keyword, (*label.names)[static_cast<std::size_t>(index)]);
+      } else if (label.keyword[0] != 'u') {
+        b += fmt::format("{}\n", label.keyword);  // back to no group or object
+      }
+    }
+    b += "f ";
+    for (int k = 0; k < 3; ++k) {
+      if (k > 0) b += ' ';
+      append_int(b, mesh.F(f, k) + 1);
+      const std::int64_t t = corner_row(w.corner_uv, w.vertex_uv, f, k);
+      const std::int64_t n = corner_row(w.corner_normal, w.vertex_normal, f, k);
+      if (t >= 0 || n >= 0) {
+        b += '/';
+        if (t >= 0) append_int(b, t + 1);
+      }
+      if (n >= 0) {
+        b += '/';
+        append_int(b, n + 1);
+      }
+    }
+    b += '\n';
     out.maybe_flush();
   }
 }
 
 void write_off(Output& out, const Mesh& mesh, const WriteOptions& options) {
   std::string& b = out.buffer();
-  const bool colors = has_colors(mesh, options);
+  const Colors colors = written_channels(mesh, MeshFormat::Off, options).color ? mesh.vertex_colors() : Colors();
+  const bool has_colors = colors.rows() > 0;
   if (options.off_binary) {
     const bool swap = host_is_little_endian();  // binary OFF is big-endian
-    b += colors ? "COFF BINARY\n" : "OFF BINARY\n";
+    b += has_colors ? "COFF BINARY\n" : "OFF BINARY\n";
     store_scalar<std::int32_t>(b, mesh.num_vertices(), swap);
     store_scalar<std::int32_t>(b, mesh.num_faces(), swap);
     store_scalar<std::int32_t>(b, 0, swap);
     for (Index v = 0; v < mesh.num_vertices(); ++v) {
       for (int c = 0; c < 3; ++c) store_scalar<float>(b, static_cast<float>(mesh.V(v, c)), swap);
-      if (colors) {
-        for (int c = 0; c < 3; ++c) store_scalar<float>(b, mesh.colors(v, c) / 255.0f, swap);
+      if (has_colors) {
+        for (int c = 0; c < 3; ++c) store_scalar<float>(b, colors(v, c) / 255.0f, swap);
         store_scalar<float>(b, 1.0f, swap);
       }
       out.maybe_flush();
@@ -413,13 +586,13 @@ void write_off(Output& out, const Mesh& mesh, const WriteOptions& options) {
     }
     return;
   }
-  b += colors ? "COFF\n" : "OFF\n";
+  b += has_colors ? "COFF\n" : "OFF\n";
   // After the keyword line, which many readers (PMP's) expect first.
   append_comments(b, "# ", mesh);
   b += fmt::format("{} {} 0\n", mesh.num_vertices(), mesh.num_faces());
   for (Index v = 0; v < mesh.num_vertices(); ++v) {
     append_position(b, "", mesh, v);
-    if (colors) b += fmt::format(" {} {} {} 255", mesh.colors(v, 0), mesh.colors(v, 1), mesh.colors(v, 2));
+    if (has_colors) b += fmt::format(" {} {} {} 255", colors(v, 0), colors(v, 1), colors(v, 2));
     b += '\n';
     out.maybe_flush();
   }
@@ -429,18 +602,10 @@ void write_off(Output& out, const Mesh& mesh, const WriteOptions& options) {
   }
 }
 
-void write_ply(Output& out, const std::string& name, const Mesh& mesh, const WriteOptions& options) {
+void write_ply(Output& out, const Mesh& mesh, const WriteOptions& options) {
   std::string& b = out.buffer();
-  const bool colors = has_colors(mesh, options);
-  std::vector<const VertexProperty*> properties;
-  if (options.write_vertex_properties) {
-    for (const auto& p : mesh.vertex_properties) {
-      if (p.values.size() != mesh.V.rows())
-        fail(name, "vertex property '" + p.name + "' has " + std::to_string(p.values.size()) + " values for " +
-                       std::to_string(mesh.V.rows()) + " vertices");
-      properties.push_back(&p);
-    }
-  }
+  const Written w = written_channels(mesh, MeshFormat::Ply, options);
+  const AttributeChannel* texcoord = w.corner_uv ? &w.corner_uv->channel : nullptr;
   const char* coordinate = options.ply_double_precision ? "double" : "float";
   b += "ply\nformat ";
   b += options.ply_encoding == PlyEncoding::Ascii             ? "ascii"
@@ -450,23 +615,51 @@ void write_ply(Output& out, const std::string& name, const Mesh& mesh, const Wri
   append_comments(b, "comment ", mesh);
   b += fmt::format("element vertex {}\nproperty {} x\nproperty {} y\nproperty {} z\n", mesh.num_vertices(), coordinate,
                    coordinate, coordinate);
-  if (colors) b += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
-  for (const auto* p : properties) b += fmt::format("property double {}\n", p->name);
-  b += fmt::format("element face {}\nproperty list uchar int vertex_indices\nend_header\n", mesh.num_faces());
+  for (const AttributeChannel* c : w.vertex)
+    for (const std::string& component : c->components) b += fmt::format("property {} {}\n", ply_type_name(c->type), component);
+  b += fmt::format("element face {}\nproperty list uchar int vertex_indices\n", mesh.num_faces());
+  for (const AttributeChannel* c : w.face)
+    for (const std::string& component : c->components) b += fmt::format("property {} {}\n", ply_type_name(c->type), component);
+  if (texcoord) b += fmt::format("property list uchar {} {}\n", ply_type_name(texcoord->type),
+                                 texcoord->name == "uv" ? "texcoord" : texcoord->name);
+  b += "end_header\n";
+  // A corner without a texture coordinate (OBJ `f 1 2/3 4`) is written as (0, 0).
+  auto texcoord_value = [&](Index f, int k, int c) {
+    const std::int32_t row = w.corner_uv->corners(f, k);
+    return row >= 0 ? texcoord->values(row, c) : 0.0;
+  };
 
   if (options.ply_encoding == PlyEncoding::Ascii) {
     for (Index v = 0; v < mesh.num_vertices(); ++v) {
       append_position(b, "", mesh, v, !options.ply_double_precision);
-      if (colors) b += fmt::format(" {} {} {}", mesh.colors(v, 0), mesh.colors(v, 1), mesh.colors(v, 2));
-      for (const auto* p : properties) {
-        b += ' ';
-        append_double(b, p->values[v]);
-      }
+      for (const AttributeChannel* c : w.vertex)
+        for (int k = 0; k < c->width(); ++k) {
+          b += ' ';
+          append_value(b, c->values(v, k), c->type);
+        }
       b += '\n';
       out.maybe_flush();
     }
     for (Index f = 0; f < mesh.num_faces(); ++f) {
-      append_face(b, "3 ", mesh, f);
+      b += "3 ";
+      for (int k = 0; k < 3; ++k) {
+        if (k > 0) b += ' ';
+        append_int(b, mesh.F(f, k));
+      }
+      for (const AttributeChannel* c : w.face)
+        for (int k = 0; k < c->width(); ++k) {
+          b += ' ';
+          append_value(b, c->values(f, k), c->type);
+        }
+      if (texcoord) {
+        b += " 6";
+        for (int k = 0; k < 3; ++k)
+          for (int c = 0; c < 2; ++c) {
+            b += ' ';
+            append_value(b, texcoord_value(f, k, c), texcoord->type);
+          }
+      }
+      b += '\n';
       out.maybe_flush();
     }
     return;
@@ -479,13 +672,20 @@ void write_ply(Output& out, const std::string& name, const Mesh& mesh, const Wri
       else
         store_scalar<float>(b, static_cast<float>(mesh.V(v, c)), swap);
     }
-    if (colors) b.append(reinterpret_cast<const char*>(mesh.colors.row(v).data()), 3);
-    for (const auto* p : properties) store_scalar<double>(b, p->values[v], swap);
+    for (const AttributeChannel* c : w.vertex)
+      for (int k = 0; k < c->width(); ++k) store_value(b, c->values(v, k), c->type, swap);
     out.maybe_flush();
   }
   for (Index f = 0; f < mesh.num_faces(); ++f) {
     b += static_cast<char>(3);
     for (int c = 0; c < 3; ++c) store_scalar<std::int32_t>(b, mesh.F(f, c), swap);
+    for (const AttributeChannel* c : w.face)
+      for (int k = 0; k < c->width(); ++k) store_value(b, c->values(f, k), c->type, swap);
+    if (texcoord) {
+      b += static_cast<char>(6);
+      for (int k = 0; k < 3; ++k)
+        for (int c = 0; c < 2; ++c) store_value(b, texcoord_value(f, k, c), texcoord->type, swap);
+    }
     out.maybe_flush();
   }
 }
@@ -540,15 +740,20 @@ void write_mesh(const std::filesystem::path& path, const Mesh& mesh, const Write
   const std::string name = path.string();
   if (mesh.F.rows() > 0 && (mesh.F.minCoeff() < 0 || mesh.F.maxCoeff() >= mesh.V.rows()))
     io_detail::fail(name, "cannot write: a face references a vertex that does not exist");
+  try {
+    mesh.attributes.validate(mesh.V.rows(), mesh.F.rows());
+  } catch (const std::invalid_argument& e) {
+    io_detail::fail(name, e.what());
+  }
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) io_detail::fail(name, "is a directory");
   io_detail::Output out(path, is_gzip_path(path));
   switch (format) {
     case MeshFormat::Obj:
-      io_detail::write_obj(out, mesh);
+      io_detail::write_obj(out, mesh, options);
       break;
     case MeshFormat::Ply:
-      io_detail::write_ply(out, name, mesh, options);
+      io_detail::write_ply(out, mesh, options);
       break;
     case MeshFormat::Off:
       io_detail::write_off(out, mesh, options);
@@ -558,6 +763,29 @@ void write_mesh(const std::filesystem::path& path, const Mesh& mesh, const Write
       break;
   }
   out.commit();
+}
+
+std::vector<std::string> attributes_not_written(const Mesh& mesh, MeshFormat format, const WriteOptions& options) {
+  const io_detail::Written w = io_detail::written_channels(mesh, format, options);
+  const MeshAttributes& a = mesh.attributes;
+  std::vector<std::string> out;
+  auto contains = [](const auto& list, const auto* item) {
+    return std::find(list.begin(), list.end(), item) != list.end();
+  };
+  for (const AttributeChannel& c : a.vertex)
+    if (!contains(w.vertex, &c) && &c != w.vertex_uv && &c != w.vertex_normal && &c != w.color)
+      out.push_back("vertex " + c.name);
+  for (const CornerChannel& c : a.corner)
+    if (&c != w.corner_uv && &c != w.corner_normal) out.push_back("corner " + c.channel.name);
+  for (const AttributeChannel& c : a.face)
+    if (!contains(w.face, &c)) out.push_back("face " + c.name);
+  if (!w.names) {
+    if (!a.materials.empty()) out.push_back("material names");
+    if (!a.groups.empty()) out.push_back("group names");
+    if (!a.objects.empty()) out.push_back("object names");
+    if (!a.material_libraries.empty()) out.push_back("mtllib");
+  }
+  return out;
 }
 
 void write_text_file(const std::filesystem::path& path, std::string_view text) {

@@ -6,26 +6,6 @@
 
 namespace vertexflow {
 
-void Mesh::set_vertex_property(std::string name, Eigen::VectorXd values) {
-  if (values.size() != V.rows())
-    throw std::invalid_argument("vertex property '" + name + "' has " + std::to_string(values.size()) + " values for " +
-                                std::to_string(V.rows()) + " vertices");
-  for (auto& p : vertex_properties) {
-    if (p.name == name) {
-      p.values = std::move(values);
-      return;
-    }
-  }
-  vertex_properties.push_back({std::move(name), std::move(values)});
-}
-
-const VertexProperty* Mesh::find_vertex_property(std::string_view name) const {
-  for (const auto& p : vertex_properties) {
-    if (p.name == name) return &p;
-  }
-  return nullptr;
-}
-
 BoundingBox bounding_box(const Vertices& V) {
   BoundingBox box;
   if (V.rows() == 0) return box;

@@ -74,6 +74,11 @@ EdgeFlipResult flip_edges_toward(const Vertices& V, const Faces& F, const Distan
   auto rms = [&] { return area > 0 ? std::sqrt(error.sum() / area) : 0.0; };
   report.rms_before = rms();
 
+  // Fixed edges stay edges: a flip removes only the edge it flips, so checking that edge suffices.
+  std::vector<std::int64_t> fixed;
+  for (const auto& [a, b] : options.fixed_edges)
+    if (a >= 0 && b >= 0 && a < n && b < n && a != b) fixed.push_back(edge_key(a, b, n));
+  std::sort(fixed.begin(), fixed.end());
   for (int pass = 0; pass < options.max_passes; ++pass) {
     // Half-edges (a -> b of face f, corner k) sorted by undirected edge: an interior manifold
     // edge is a run of exactly two, one each way.
@@ -115,7 +120,7 @@ EdgeFlipResult flip_edges_toward(const Vertices& V, const Faces& F, const Distan
           c.b = b;
           c.c = G(h1.f, (h1.k + 2) % 3);
           c.d = G(h2.f, (h2.k + 2) % 3);
-          if (c.c != c.d) candidates.push_back(c);
+          if (c.c != c.d && !std::binary_search(fixed.begin(), fixed.end(), half[i].key)) candidates.push_back(c);
         }
       }
       i = j;

@@ -53,6 +53,7 @@ void to_json(nlohmann::json& j, const FlowOptions& options) {
             {"feature_angle", options.feature_angle},
             {"fix_boundary", options.constraints.fix_boundary},
             {"pinned", options.constraints.pinned.size()},
+            {"crease_edges", options.constraints.crease_edges.size()},
             {"refuse_non_manifold", options.refuse_non_manifold},
             {"max_halvings", options.guard.max_halvings},
             {"min_quality", options.guard.min_quality},
@@ -99,6 +100,7 @@ void to_json(nlohmann::json& j, const UnsharpOptions& options) {
        {"smoothing_iterations", options.smoothing_iterations},
        {"fix_boundary", options.constraints.fix_boundary},
        {"pinned", options.constraints.pinned.size()},
+       {"crease_edges", options.constraints.crease_edges.size()},
        {"refuse_non_manifold", options.refuse_non_manifold}};
 }
 
@@ -119,6 +121,7 @@ void to_json(nlohmann::json& j, const FitOptions& options) {
        {"tolerance", options.tolerance},
        {"fix_boundary", options.constraints.fix_boundary},
        {"pinned", options.constraints.pinned.size()},
+       {"crease_edges", options.constraints.crease_edges.size()},
        {"min_quality", options.guard.min_quality},
        {"sliver_floor", options.guard.sliver_floor},
        {"seed", options.seed}};

@@ -94,12 +94,13 @@ TEST(CliCurvature, WritesPropertiesAndColours) {
   const Mesh mesh = read_mesh(out);
   for (const char* name : {"k1", "k2", "H", "K", "T1x", "T1y", "T1z", "T2x", "T2y", "T2z"})
     EXPECT_NE(mesh.find_vertex_property(name), nullptr) << name;
-  EXPECT_EQ(mesh.colors.rows(), mesh.num_vertices());
+  const Colors colors = mesh.vertex_colors();
+  EXPECT_EQ(colors.rows(), mesh.num_vertices());
   // Positive mean curvature is red, on the outer equator of the torus.
   const Eigen::VectorXd& H = mesh.find_vertex_property("H")->values;
   Index most_positive = 0;
   H.maxCoeff(&most_positive);
-  EXPECT_GT(mesh.colors(most_positive, 0), mesh.colors(most_positive, 2));
+  EXPECT_GT(colors(most_positive, 0), colors(most_positive, 2));
 }
 
 TEST(CliCurvature, RefusesToOverwriteTheInputAndTakesNonManifoldMeshes) {

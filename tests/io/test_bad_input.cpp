@@ -103,7 +103,7 @@ const std::map<std::string, std::string> kExpected = {
     {"ply_list_count_2pow31.ply", "invalid list length 2147483648 for property 'vertex_indices'"},
     {"ply_list_count_negative.ply", "invalid list length -1 for property 'vertex_indices'"},
     // PLY: values.
-    {"fuzz_ply_ascii_colour_out_of_range.ply", "line 25: vertex colour 30020 is outside 0..255"},
+    {"fuzz_ply_ascii_colour_out_of_range.ply", "line 25: vertex property 'red' value 30020 is not a uint8"},
     {"ply_ascii_not_a_number.ply", "line 11: expected a vertex coordinate, found 'zero'"},
     {"ply_ascii_float_index.ply", "line 13: a face vertex index must be an integer"},
     {"ply_ascii_index_out_of_range.ply", "face 0 references vertex 7, but the file has 3 vertices"},

@@ -80,15 +80,14 @@ TEST(ReadMesh, FormatsAreDetected) {
 }
 
 TEST(ReadMesh, PlyVertexPropertiesAreKept) {
-  // horse-48k.ply carries normals nx, ny, nz as float properties.
+  // horse-48k.ply carries normals nx, ny, nz as float properties: one Normal channel.
   const Mesh mesh = read_mesh(data_path("horse-48k.ply"));
-  const VertexProperty* nx = mesh.find_vertex_property("nx");
-  ASSERT_NE(nx, nullptr);
-  ASSERT_EQ(nx->values.size(), mesh.num_vertices());
-  const VertexProperty* ny = mesh.find_vertex_property("ny");
-  const VertexProperty* nz = mesh.find_vertex_property("nz");
-  ASSERT_NE(ny, nullptr);
-  ASSERT_NE(nz, nullptr);
+  const AttributeChannel* normal = mesh.attributes.find_vertex("normal");
+  ASSERT_NE(normal, nullptr);
+  EXPECT_EQ(normal->role, AttributeRole::Normal);
+  EXPECT_EQ(normal->type, ScalarType::Float32);
+  EXPECT_EQ(normal->components, (std::vector<std::string>{"nx", "ny", "nz"}));
+  ASSERT_EQ(normal->rows(), mesh.num_vertices());
   // The stored normals (not normalised in this file) point like the area-weighted face normals.
   Vertices face_normal_sum = Vertices::Zero(mesh.num_vertices(), 3);
   for (Index f = 0; f < mesh.num_faces(); ++f) {
@@ -98,7 +97,7 @@ TEST(ReadMesh, PlyVertexPropertiesAreKept) {
   }
   Index agreeing = 0;
   for (Index v = 0; v < mesh.num_vertices(); ++v) {
-    const Eigen::Vector3d stored(nx->values[v], ny->values[v], nz->values[v]);
+    const Eigen::Vector3d stored = normal->values.row(v).transpose();
     agreeing += stored.normalized().dot(face_normal_sum.row(v).normalized()) > 0.9;
   }
   EXPECT_GT(agreeing, 0.99 * mesh.num_vertices());
@@ -217,7 +216,8 @@ TEST(ReadObj, ABackslashEndingALineContinuesTheStatement) {
     EXPECT_EQ(mesh.V, expected.V);
     EXPECT_EQ(mesh.F, expected.F);
     EXPECT_EQ(report.polygons_triangulated, 2);
-    // The spec allows it: no warning (but the one naming the vn statement, which is not kept).
+    // The spec allows it: no warning (but the one naming texture and normal indices without a
+    // vt or vn table, which are not kept).
     std::vector<std::string> warnings = report.warnings();
     std::erase_if(warnings, [](const std::string& w) { return w.rfind("not kept", 0) == 0; });
     EXPECT_EQ(warnings, plain_report.warnings());
@@ -390,11 +390,16 @@ TEST(ReadPly, AsciiWithColoursAndProperties) {
       "0 0 0 255 0 0 0.5\n1 0 0 0 255 0 -1.5\n0 1 0 0 0 255 2\n3 0 1 2 7\n";
   const Mesh mesh = read_text(ply, MeshFormat::Ply);
   ASSERT_EQ(mesh.num_faces(), 1);
-  ASSERT_EQ(mesh.colors.rows(), 3);
-  EXPECT_EQ(mesh.colors(1, 1), 255);
-  const VertexProperty* k1 = mesh.find_vertex_property("k1");
+  ASSERT_EQ(mesh.vertex_colors().rows(), 3);
+  EXPECT_EQ(mesh.vertex_colors()(1, 1), 255);
+  const AttributeChannel* k1 = mesh.find_vertex_property("k1");
   ASSERT_NE(k1, nullptr);
-  EXPECT_EQ(k1->values[1], -1.5);
+  EXPECT_EQ(k1->values(1, 0), -1.5);
+  // The face property is a face channel with its type.
+  const AttributeChannel* flags = mesh.attributes.find_face("flags");
+  ASSERT_NE(flags, nullptr);
+  EXPECT_EQ(flags->type, ScalarType::Int32);
+  EXPECT_EQ(flags->values(0, 0), 7);
 }
 
 TEST(ReadMesh, ErrorsStayOnOneLineWhateverTheFileName) {
@@ -486,21 +491,20 @@ TEST(ReadPly, TriangleStripsBecomeTriangles) {
   }
 }
 
-// What a file holds and the mesh does not keep is named, with counts, in one warning line.
+// What a file holds and the mesh does not keep is named, with counts, in one warning line; what
+// it keeps (attributes.h) is not.
 TEST(ReadReport, AttributesNotKeptAreNamed) {
   const std::string obj =
       "mtllib a.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nvn 0 0 1\ng part\n"
-      "usemtl red\ns 1\nf 1/1/1 2/2/1 3/3/1\nusemtl blue\nf 2/2/1 4/1/1 3/3/1\n";
+      "usemtl red\ns 1\nf 1/1/1 2/2/1 3/3/1\nusemtl blue\nf 2/2/1 4/1/1 3/3/1\nl 1 2\nl 2 3\n";
   ReadReport report;
-  (void)read_mesh_from_memory(obj, MeshFormat::Obj, "a.obj", &report);
-  const std::vector<std::string> expected = {
-      "material libraries mtllib (1)", "texture coordinates vt (3)", "normals vn (1)", "groups g (1)",
-      "material switches usemtl (2)",  "smoothing groups s (1)"};
-  EXPECT_EQ(report.not_kept, expected);
+  const Mesh mesh = read_mesh_from_memory(obj, MeshFormat::Obj, "a.obj", &report);
+  EXPECT_EQ(report.not_kept, std::vector<std::string>{"OBJ lines l (2)"});
   const std::vector<std::string> warnings = report.warnings();
   ASSERT_EQ(warnings.size(), 1u);
-  EXPECT_NE(warnings[0].find("not kept"), std::string::npos);
-  EXPECT_NE(warnings[0].find("texture coordinates vt (3)"), std::string::npos);
+  EXPECT_EQ(warnings[0], "not kept: OBJ lines l (2)");
+  EXPECT_NE(mesh.attributes.find_corner("uv"), nullptr);
+  EXPECT_NE(mesh.attributes.find_face("material"), nullptr);
 
   const std::string ply =
       "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
@@ -509,8 +513,7 @@ TEST(ReadReport, AttributesNotKeptAreNamed) {
       "0 0 0 0\n1 0 0 0\n0 1 0 0\n3 0 1 2 7\n0 1\n1 2\n";
   ReadReport ply_report;
   (void)read_mesh_from_memory(ply, MeshFormat::Ply, "a.ply", &ply_report);
-  const std::vector<std::string> ply_expected = {"PLY vertex property 'neighbours' (3)",
-                                                 "PLY face property 'material' (1)", "PLY element 'edge' (2)"};
+  const std::vector<std::string> ply_expected = {"PLY vertex list property 'neighbours' (3)", "PLY element 'edge' (2)"};
   EXPECT_EQ(ply_report.not_kept, ply_expected);
   // A file with nothing beyond positions and faces warns of nothing.
   ReadReport plain;

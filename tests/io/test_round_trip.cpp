@@ -46,8 +46,9 @@ Mesh test_mesh() {
   Mesh mesh = read_mesh(test::data_path("bunny_uniform.off"));
   mesh.V.col(0) *= 1.0 / 3.0;  // full-precision doubles
   mesh.V.col(1).array() += 1e-7;
-  mesh.colors.resize(mesh.num_vertices(), 3);
-  for (Index v = 0; v < mesh.num_vertices(); ++v) mesh.colors.row(v) << v % 256, (7 * v) % 256, 255;
+  Colors colors(mesh.num_vertices(), 3);
+  for (Index v = 0; v < mesh.num_vertices(); ++v) colors.row(v) << v % 256, (7 * v) % 256, 255;
+  mesh.set_vertex_colors(colors);
   mesh.set_vertex_property("k1", mesh.V.col(0) * 12.5);
   return mesh;
 }
@@ -80,9 +81,9 @@ TEST_P(RoundTrip, ReadWriteReadIsIdentity) {
     }
   }
   if (c.keeps_properties) {
-    ASSERT_EQ(back.colors.rows(), original.colors.rows());
-    EXPECT_EQ(back.colors, original.colors);
-    const VertexProperty* k1 = back.find_vertex_property("k1");
+    ASSERT_EQ(back.vertex_colors().rows(), original.vertex_colors().rows());
+    EXPECT_EQ(back.vertex_colors(), original.vertex_colors());
+    const AttributeChannel* k1 = back.find_vertex_property("k1");
     ASSERT_NE(k1, nullptr);
     EXPECT_EQ(k1->values, original.find_vertex_property("k1")->values);
   }

@@ -33,7 +33,8 @@ TEST(WriteMesh, FailureLeavesExistingFileUntouchedAndNoTemporary) {
   const auto path = dir.file("out.ply");
   { std::ofstream(path) << "precious"; }
   Mesh bad = triangle();
-  bad.vertex_properties.push_back({"broken", Eigen::VectorXd::Zero(2)});  // wrong size: fails mid-write
+  bad.set_vertex_property("broken", Eigen::VectorXd::Zero(3));
+  bad.attributes.vertex.back().values.resize(2, 1);  // wrong size: the write fails
   EXPECT_THROW(write_mesh(path, bad), IoError);
   EXPECT_EQ(test::read_text(path), "precious");
   EXPECT_EQ(count_entries(dir.path()), 1);
@@ -116,7 +117,8 @@ TEST_P(WriteBothWays, FailureLeavesNoTemporaryFile) {
   const auto path = dir.file("out.ply");
   { std::ofstream(path) << "precious"; }
   Mesh bad = triangle();
-  bad.vertex_properties.push_back({"broken", Eigen::VectorXd::Zero(2)});
+  bad.set_vertex_property("broken", Eigen::VectorXd::Zero(3));
+  bad.attributes.vertex.back().values.resize(2, 1);
   EXPECT_THROW(write_mesh(path, bad), IoError);
   EXPECT_EQ(test::read_text(path), "precious");
   write_mesh(path, triangle());
@@ -151,30 +153,31 @@ INSTANTIATE_TEST_SUITE_P(TemporaryFile, WriteBothWays, ::testing::Values(false, 
 TEST(WriteMesh, OptionsLeaveOutColoursAndProperties) {
   test::ScratchDir dir("options");
   Mesh mesh = triangle();
-  mesh.colors = Colors::Constant(3, 3, 200);
+  mesh.set_vertex_colors(Colors::Constant(3, 3, 200));
   mesh.set_vertex_property("k1", Eigen::Vector3d(1, 2, 3));
   WriteOptions options;
   options.write_colors = false;
   options.write_vertex_properties = false;
   write_mesh(dir.file("plain.ply"), mesh, options);
   const Mesh plain = read_mesh(dir.file("plain.ply"));
-  EXPECT_EQ(plain.colors.rows(), 0);
-  EXPECT_TRUE(plain.vertex_properties.empty());
+  EXPECT_EQ(plain.vertex_colors().rows(), 0);
+  EXPECT_TRUE(plain.attributes.vertex.empty());
   write_mesh(dir.file("full.ply"), mesh);
   const Mesh full = read_mesh(dir.file("full.ply"));
-  EXPECT_EQ(full.colors.rows(), 3);
+  EXPECT_EQ(full.vertex_colors().rows(), 3);
   ASSERT_NE(full.find_vertex_property("k1"), nullptr);
 }
 
 TEST(WriteMesh, PropertyErrorsNameTheFile) {
   test::ScratchDir dir("property-error");
   Mesh mesh = triangle();
-  mesh.vertex_properties.push_back({"short", Eigen::VectorXd::Zero(1)});
+  mesh.set_vertex_property("short", Eigen::VectorXd::Zero(3));
+  mesh.attributes.vertex.back().values.resize(1, 1);
   try {
     write_mesh(dir.file("out.ply"), mesh);
     FAIL();
   } catch (const IoError& e) {
-    EXPECT_EQ(std::string(e.what()).rfind(dir.file("out.ply").string() + ": vertex property 'short' has 1 values", 0), 0u)
+    EXPECT_EQ(std::string(e.what()).rfind(dir.file("out.ply").string() + ": attributes: vertex channel 'short' has 1 rows for 3 vertices", 0), 0u)
         << e.what();
   }
 }

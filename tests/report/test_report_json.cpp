@@ -66,7 +66,7 @@ TEST(ReportJson, FlowOptionsEveryField) {
   FlowOptions options;
   auto& [weights, d_percentile, iterations, project_to_input, feature_angle, constraints, refuse_non_manifold, guard,
          curvature, solver, solver_tolerance, density] = options;
-  auto& [fix_boundary, pinned] = constraints;
+  auto& [fix_boundary, pinned, crease_edges] = constraints;
   auto& [min_quality, sliver_floor, max_halvings] = guard;
   weights.lambda = 0.25;
   weights.mu = 0.75;
@@ -79,6 +79,7 @@ TEST(ReportJson, FlowOptionsEveryField) {
   feature_angle = 30;
   fix_boundary = false;
   pinned = {4, 8, 15};
+  crease_edges = {{1, 2}};
   refuse_non_manifold = true;
   max_halvings = 12;
   min_quality = 0.2;
@@ -97,7 +98,8 @@ TEST(ReportJson, FlowOptionsEveryField) {
   EXPECT_EQ(j, nlohmann::json::parse(R"({
     "lambda": 0.25, "mu": 0.75, "epsilon": 1e-4, "fairness_target": "zero", "sliver": 0.5,
     "d_percentile": 95.0, "iterations": 3, "project_to_input": false, "feature_angle": 30.0,
-    "fix_boundary": false, "pinned": 3, "refuse_non_manifold": true, "max_halvings": 12, "min_quality": 0.2,
+    "fix_boundary": false, "pinned": 3, "crease_edges": 1, "refuse_non_manifold": true, "max_halvings": 12,
+    "min_quality": 0.2,
     "sliver_floor": 0.25,
     "curvature": {"normal_weighting": "area", "smoothing_rounds": 1},
     "solver": "conjugate gradients, multilevel", "solver_tolerance": 1e-9,
@@ -164,15 +166,16 @@ TEST(ReportJson, FlowReportEveryFieldInItsSection) {
 TEST(ReportJson, UnsharpOptionsAndResultEveryField) {
   UnsharpOptions options;
   auto& [weight, smoothing_iterations, constraints, refuse_non_manifold] = options;
-  auto& [fix_boundary, pinned] = constraints;
+  auto& [fix_boundary, pinned, crease_edges] = constraints;
   weight = 0.5;
   smoothing_iterations = 7;
   fix_boundary = false;
   pinned = {1, 2};
+  crease_edges = {{1, 2}, {2, 3}};
   refuse_non_manifold = true;
   const nlohmann::json j = options;
   EXPECT_EQ(j, nlohmann::json::parse(R"({"weight": 0.5, "smoothing_iterations": 7, "fix_boundary": false,
-                                         "pinned": 2, "refuse_non_manifold": true})"));
+                                         "pinned": 2, "crease_edges": 2, "refuse_non_manifold": true})"));
   expect_every_value_differs(j, UnsharpOptions{});
 
   UnsharpResult result;

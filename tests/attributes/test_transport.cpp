@@ -1,0 +1,309 @@
+// Attributes follow the moved vertices (enhance.h, docs/attributes.md): texture coordinates
+// re-sampled in their own chart do not swim, seam vertices stay on their seams, the face list
+// comes back as it went in.
+#include "test_support.h"
+
+#include "vertexflow/enhance.h"
+#include "vertexflow/io.h"
+#include "vertexflow/topology.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <array>
+#include <functional>
+#include <map>
+#include <optional>
+#include <numbers>
+
+namespace vertexflow {
+namespace {
+
+// A parametric surface on a (nu x nv) grid of quads, each split in two, with texture coordinates
+// (i / nu, j / nv) per corner: where the surface closes (wrap_u, wrap_v) the vertices are
+// shared and the texture coordinates are not, so the closing line is a seam. Without wrap_v the
+// rows j = 0 and j = nv are the poles of a sphere (collapse_v): one vertex each, with its own
+// texture coordinate in every face.
+struct Parametric {
+  Mesh mesh;
+  std::vector<char> on_seam;  // per vertex
+};
+
+Parametric parametric(int nu, int nv, bool wrap_v, const std::function<Eigen::Vector3d(double, double)>& at) {
+  Parametric p;
+  Mesh& m = p.mesh;
+  const bool poles = !wrap_v;
+  const int rows = wrap_v ? nv : nv - 1;  // rows of shared vertices (poles apart)
+  auto vertex = [&](int i, int j) -> Index {  // i mod nu; j in 0..nv
+    i = (i % nu + nu) % nu;
+    if (wrap_v) return static_cast<Index>((j % nv) * nu + i);
+    if (j == 0) return rows * nu;
+    if (j == nv) return rows * nu + 1;
+    return static_cast<Index>((j - 1) * nu + i);
+  };
+  m.V.resize(rows * nu + (poles ? 2 : 0), 3);
+  for (int j = 0; j <= nv; ++j)
+    for (int i = 0; i < nu; ++i) m.V.row(vertex(i, j)) = at(double(i) / nu, double(j) / nv).transpose();
+  std::vector<std::array<Index, 3>> faces;
+  std::vector<std::array<Eigen::Vector2d, 3>> uvs;
+  auto uv = [&](int i, int j) { return Eigen::Vector2d(double(i) / nu, double(j) / nv); };
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i) {
+      const Index a = vertex(i, j), b = vertex(i + 1, j), c = vertex(i + 1, j + 1), d = vertex(i, j + 1);
+      if (!(poles && j == 0)) {
+        faces.push_back({a, b, c});
+        uvs.push_back({uv(i, j), uv(i + 1, j), uv(i + 1, j + 1)});
+      } else {
+        faces.push_back({a, c, d});  // the pole a: one triangle
+        uvs.push_back({Eigen::Vector2d((i + 0.5) / nu, 0), uv(i + 1, j + 1), uv(i, j + 1)});
+        continue;
+      }
+      if (poles && j == nv - 1) continue;  // c is the other pole: (a, b, c) was the triangle
+      faces.push_back({a, c, d});
+      uvs.push_back({uv(i, j), uv(i + 1, j + 1), uv(i, j + 1)});
+    }
+  m.F.resize(static_cast<Eigen::Index>(faces.size()), 3);
+  CornerChannel uv_channel;
+  uv_channel.channel.name = "uv";
+  uv_channel.channel.components = {"u", "v"};
+  uv_channel.channel.role = AttributeRole::TexCoord;
+  uv_channel.corners.resize(m.F.rows(), 3);
+  std::vector<Eigen::Vector2d> table;
+  std::map<std::pair<long, long>, int> row_of;
+  for (std::size_t f = 0; f < faces.size(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      m.F(static_cast<Eigen::Index>(f), k) = faces[f][static_cast<std::size_t>(k)];
+      const Eigen::Vector2d t = uvs[f][static_cast<std::size_t>(k)];
+      const std::pair<long, long> key{std::lround(t.x() * 1e6), std::lround(t.y() * 1e6)};
+      auto [it, added] = row_of.emplace(key, static_cast<int>(table.size()));
+      if (added) table.push_back(t);
+      uv_channel.corners(static_cast<Eigen::Index>(f), k) = it->second;
+    }
+  uv_channel.channel.values.resize(static_cast<Eigen::Index>(table.size()), 2);
+  for (std::size_t r = 0; r < table.size(); ++r) uv_channel.channel.values.row(static_cast<Eigen::Index>(r)) = table[r];
+  m.attributes.corner.push_back(std::move(uv_channel));
+  p.on_seam.assign(static_cast<std::size_t>(m.num_vertices()), 0);
+  for (int j = 0; j <= nv; ++j) {
+    p.on_seam[static_cast<std::size_t>(vertex(0, j))] = 1;
+    if (wrap_v) p.on_seam[static_cast<std::size_t>(vertex(j, 0))] = 1;
+  }
+  if (wrap_v)
+    for (int i = 0; i < nu; ++i) p.on_seam[static_cast<std::size_t>(vertex(i, 0))] = 1;
+  if (poles) p.on_seam[static_cast<std::size_t>(vertex(0, 0))] = p.on_seam[static_cast<std::size_t>(vertex(0, nv))] = 1;
+  return p;
+}
+
+Parametric uv_sphere(int nu, int nv) {
+  return parametric(nu, nv, false, [](double u, double v) {
+    const double phi = 2 * std::numbers::pi * u, theta = std::numbers::pi * v;
+    return Eigen::Vector3d(std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi), std::cos(theta));
+  });
+}
+
+// A torus whose tube is an ellipse, so that the flow has curvature to move towards.
+Parametric textured_torus(int nu, int nv) {
+  return parametric(nu, nv, true, [](double u, double v) {
+    const double phi = 2 * std::numbers::pi * u, theta = 2 * std::numbers::pi * v;
+    const double rho = 1 + 0.45 * std::cos(theta);
+    return Eigen::Vector3d(rho * std::cos(phi), rho * std::sin(phi), 0.2 * std::sin(theta));
+  });
+}
+
+// The point of the input surface whose texture coordinate is t: the face whose UV triangle
+// holds t, at the same barycentric coordinates (the input's UV-to-surface map).
+struct SurfacePoint {
+  Eigen::Vector3d point, normal;
+};
+
+std::optional<SurfacePoint> surface_at(const Mesh& input, const Eigen::Vector2d& t) {
+  const CornerChannel& uv = input.attributes.corner.front();
+  for (Index f = 0; f < input.num_faces(); ++f) {
+    Eigen::Vector2d c[3];
+    for (int k = 0; k < 3; ++k) c[k] = uv.channel.values.row(uv.corners(f, k)).transpose();
+    const Eigen::Vector2d e1 = c[1] - c[0], e2 = c[2] - c[0], d = t - c[0];
+    const double det = e1.x() * e2.y() - e1.y() * e2.x();
+    if (std::abs(det) < 1e-300) continue;
+    const double b1 = (d.x() * e2.y() - d.y() * e2.x()) / det, b2 = (e1.x() * d.y() - e1.y() * d.x()) / det;
+    const double tolerance = -1e-9;
+    if (b1 < tolerance || b2 < tolerance || 1 - b1 - b2 < tolerance) continue;
+    const Eigen::Vector3d point = ((1 - b1 - b2) * input.V.row(input.F(f, 0)) + b1 * input.V.row(input.F(f, 1)) +
+                                   b2 * input.V.row(input.F(f, 2)))
+                                      .transpose();
+    return SurfacePoint{point, face_normal(input.V, input.F, f).normalized()};
+  }
+  return std::nullopt;
+}
+
+// Over the moved vertices off the seams, in mean edge lengths: how far the point of the input
+// surface that the vertex's texture coordinate names is from the vertex, in all (`_raw`) and
+// along the surface (the part across the input's face normal: a vertex that the method lifted
+// off the facets, by the flow's Phong lift or a fit's move along the normal, is that far off
+// any point of the facets whatever its texture coordinate).
+struct Swim {
+  double resampled = 0, resampled_raw = 0;
+  double kept_uv = 0, kept_uv_raw = 0;  // the same with the input's texture coordinates kept
+  Index measured = 0;
+};
+
+Swim measure_swim(const Parametric& in, const Mesh& out) {
+  const Mesh& input = in.mesh;
+  const double h = mean_edge_length(input.V, build_topology(input.F, input.num_vertices()));
+  const CornerChannel& before = input.attributes.corner.front();
+  const CornerChannel& after = out.attributes.corner.front();
+  Swim swim;
+  std::vector<char> done(static_cast<std::size_t>(input.num_vertices()), 0);
+  for (Index f = 0; f < input.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const Index v = input.F(f, k);
+      if (done[static_cast<std::size_t>(v)] || in.on_seam[static_cast<std::size_t>(v)]) continue;
+      done[static_cast<std::size_t>(v)] = 1;
+      if ((out.V.row(v) - input.V.row(v)).norm() < 1e-3 * h) continue;
+      const auto now = surface_at(input, after.channel.values.row(after.corners(f, k)).transpose());
+      const auto old = surface_at(input, before.channel.values.row(before.corners(f, k)).transpose());
+      if (!now || !old) {
+        ADD_FAILURE() << "vertex " << v << ": its texture coordinate lies in no face of the input";
+        continue;
+      }
+      const Eigen::Vector3d p = out.V.row(v).transpose();
+      auto along = [&](const SurfacePoint& s) {
+        const Eigen::Vector3d d = s.point - p;
+        return (d - d.dot(s.normal) * s.normal).norm() / h;
+      };
+      swim.resampled = std::max(swim.resampled, along(*now));
+      swim.kept_uv = std::max(swim.kept_uv, along(*old));
+      swim.resampled_raw = std::max(swim.resampled_raw, (now->point - p).norm() / h);
+      swim.kept_uv_raw = std::max(swim.kept_uv_raw, (old->point - p).norm() / h);
+      ++swim.measured;
+    }
+  return swim;
+}
+
+struct ModeCase {
+  const char* name;
+  std::function<void(EnhanceOptions&)> set;
+  bool slides;  // the method moves vertices along the surface (else mostly along the normal)
+};
+
+class NoSwimming : public ::testing::TestWithParam<ModeCase> {};
+
+TEST_P(NoSwimming, ResampledTextureCoordinatesLandWhereTheVertexIs) {
+  for (const bool torus : {false, true}) {
+    SCOPED_TRACE(torus ? "torus" : "sphere");
+    const Parametric in = torus ? textured_torus(96, 48) : uv_sphere(96, 48);
+    EnhanceOptions options;
+    GetParam().set(options);
+    const EnhanceResult result = enhance(in.mesh, nullptr, options);
+    EXPECT_EQ(result.mesh.F, in.mesh.F);
+    const Swim swim = measure_swim(in, result.mesh);
+    std::printf(
+        "[ swim     ] %s %s: %d moved vertices; along the surface re-sampled %.2e, kept %.2e; in all re-sampled "
+        "%.2e, kept %.2e (mean edge lengths)\n",
+        GetParam().name, torus ? "torus" : "sphere", static_cast<int>(swim.measured), swim.resampled, swim.kept_uv,
+        swim.resampled_raw, swim.kept_uv_raw);
+    // The acceptance bar: 1% of the mean edge length. Measured (96 x 48 grids) along the
+    // surface: 1e-14 for the flow and the density passes (the vertices stay on the input), 6.0e-3
+    // for the unsharp mask and 2.6e-3 for smooth mode (which leave it: their closest point).
+    EXPECT_LT(swim.resampled, 0.01);
+    if (GetParam().slides) {
+      // Doing nothing (the texture coordinates kept) swims by the displacement itself: measured
+      // 0.041 (flow, torus) to 0.32 (density passes), 0.078-0.131 for the unsharp mask.
+      EXPECT_GT(swim.measured, 50);
+      EXPECT_GT(swim.kept_uv, 0.02);
+      EXPECT_GT(swim.kept_uv, 3 * swim.resampled);
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Modes, NoSwimming,
+    ::testing::Values(ModeCase{"flow", [](EnhanceOptions&) {}, true},
+                      ModeCase{"density", [](EnhanceOptions& o) { o.flow.density.passes = 10; }, true},
+                      ModeCase{"unsharp", [](EnhanceOptions& o) { o.method = EnhanceMethod::Unsharp; }, true},
+                      ModeCase{"smooth", [](EnhanceOptions& o) { o.surface = EnhanceSurface::Smooth; }, false}),
+    [](const auto& param_info) { return std::string(param_info.param.name); });
+
+TEST(Seams, SeamVerticesStayOnTheirSeamPolyline) {
+  const Parametric in = uv_sphere(96, 48);
+  const EnhanceResult result = enhance(in.mesh, nullptr, EnhanceOptions{});
+  const double h = mean_edge_length(in.mesh.V, build_topology(in.mesh.F, in.mesh.num_vertices()));
+  // The seam is the meridian u = 0: its vertices from pole to pole.
+  std::vector<Index> seam;
+  for (Index v = 0; v < in.mesh.num_vertices(); ++v)
+    if (in.on_seam[static_cast<std::size_t>(v)]) seam.push_back(v);
+  double worst = 0, moved = 0;
+  for (const Index v : seam) {
+    const Eigen::Vector3d p = result.mesh.V.row(v);
+    moved = std::max(moved, (p - in.mesh.V.row(v).transpose()).norm() / h);
+    // Distance to the seam polyline: the input's meridian (y = 0, x >= 0) is a planar polyline.
+    double best = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i < seam.size(); ++i)
+      for (std::size_t j = 0; j < seam.size(); ++j) {
+        const Eigen::Vector3d a = in.mesh.V.row(seam[i]), b = in.mesh.V.row(seam[j]);
+        if (i == j || (a - b).norm() > 1.5 * (std::numbers::pi / 48)) continue;  // neighbours along the seam
+        const double t = std::clamp((p - a).dot(b - a) / (b - a).squaredNorm(), 0.0, 1.0);
+        best = std::min(best, (a + t * (b - a) - p).norm());
+      }
+    worst = std::max(worst, best / h);
+  }
+  std::printf("[ seam     ] %zu seam vertices, moved up to %.3f edge lengths, off the seam %.2e\n", seam.size(), moved,
+              worst);
+  EXPECT_LT(worst, 1e-9);
+  EXPECT_GT(moved, 0.01);  // they do slide along it
+}
+
+TEST(FaceList, ComesBackAsItWentInWithDegenerateFacesHeld) {
+  Mesh mesh = read_mesh(test::data_path("bunny_uniform.off"));
+  const Index n = mesh.num_vertices(), m = mesh.num_faces();
+  // A repeated-vertex face, a duplicate (reversed), a zero-area face on three new collinear
+  // vertices, and a vertex without faces.
+  mesh.V.conservativeResize(n + 4, 3);
+  const Eigen::RowVector3d far = mesh.V.colwise().maxCoeff() * 2;
+  for (int i = 0; i < 4; ++i) mesh.V.row(n + i) = far + Eigen::RowVector3d(i, 0, 0);
+  mesh.F.conservativeResize(m + 3, 3);
+  mesh.F.row(m) << mesh.F(10, 0), mesh.F(10, 0), mesh.F(10, 1);
+  mesh.F.row(m + 1) << mesh.F(20, 2), mesh.F(20, 1), mesh.F(20, 0);
+  mesh.F.row(m + 2) << n, n + 1, n + 2;
+  const EnhanceResult result = enhance(mesh, nullptr, EnhanceOptions{});
+  EXPECT_EQ(result.mesh.F, mesh.F);
+  ASSERT_EQ(result.mesh.num_vertices(), mesh.num_vertices());
+  for (const Index v : {mesh.F(10, 0), mesh.F(10, 1), mesh.F(20, 0), mesh.F(20, 1), mesh.F(20, 2), n, n + 1, n + 3})
+    EXPECT_EQ(result.mesh.V.row(v), mesh.V.row(v)) << v;
+  EXPECT_GT((result.mesh.V - mesh.V).rowwise().norm().maxCoeff(), 1e-3);  // the rest moved
+  EXPECT_EQ(result.report["face_list"]["faces_held"].get<int>(), 3);
+  EXPECT_FALSE(result.warnings.empty());
+}
+
+TEST(FaceList, EveryEnhanceOfTheBundledMeshesKeepsTheFaceList) {
+  ReadOptions keep;
+  keep.keep_face_list = true;
+  for (const char* name : {"bunny_uniform.off", "bunny_adaptive.off", "amo_adaptive.off", "fandisk.off",
+                           "fandisk_quads.off", "spot.obj", "suzanne.obj", "sphere_low.off", "hemisphere.off",
+                           "torus.obj", "rocker-arm.obj", "chamfer-cube.off", "camelhead.off", "max-planck-5k.obj"}) {
+    SCOPED_TRACE(name);
+    const Mesh mesh = read_mesh(test::data_path(name), nullptr, keep);
+    const EnhanceResult result = enhance(mesh, nullptr, EnhanceOptions{});
+    EXPECT_EQ(result.mesh.F, mesh.F);
+    EXPECT_EQ(result.mesh.attributes.corner.size(), mesh.attributes.corner.size());
+    EXPECT_EQ(result.mesh.attributes.face.size(), mesh.attributes.face.size());
+  }
+}
+
+TEST(Spot, TextureCoordinatesAreResampledNotKept) {
+  const Mesh spot = read_mesh(test::data_path("spot.obj"));
+  const EnhanceResult result = enhance(spot, nullptr, EnhanceOptions{});
+  const nlohmann::json& a = result.report["attributes"];
+  std::printf("[ spot     ] %s\n", a.dump().c_str());
+  EXPECT_GT(a["vertices_moved"].get<int>(), 1000);
+  // spot's texture has seams: they are creases for the flow.
+  EXPECT_GT(a["chart_boundary_edges"].get<int>(), 100);
+  // The flow's vertices stay on the surface, Phong-lifted off its facets: measured 0.146 mean
+  // edge lengths at most (spot is coarse where it is most curved).
+  EXPECT_LT(a["max_location_distance_edges"].get<double>(), 0.3);
+  const CornerChannel& before = spot.attributes.corner.front();
+  const CornerChannel& after = result.mesh.attributes.corner.front();
+  EXPECT_EQ(after.corners.rows(), before.corners.rows());
+  EXPECT_FALSE(after.channel.values == before.channel.values);
+}
+
+}  // namespace
+}  // namespace vertexflow
