@@ -4,6 +4,7 @@
 #include "vertexflow/io.h"
 
 #include <cmath>
+#include <initializer_list>
 
 namespace vertexflow::python {
 
@@ -76,6 +77,217 @@ Mesh to_mesh(const py::handle& V, const py::handle& F, const char* v_name, const
 
 py::tuple mesh_tuple(Mesh&& mesh) {
   return py::make_tuple(to_numpy(std::move(mesh.V)), to_numpy(std::move(mesh.F)));
+}
+
+namespace {
+
+constexpr int kScalarTypes = 8;  // ScalarType's enumerators, Int8 .. Float64
+constexpr int kRoles = 6;        // AttributeRole's, Generic .. Weights
+
+py::list string_list(const std::vector<std::string>& strings) {
+  py::list list;
+  for (const std::string& s : strings) list.append(py::str(s));
+  return list;
+}
+
+py::dict channel_to_python(AttributeChannel&& channel) {
+  py::dict d;
+  d["name"] = py::str(channel.name);
+  d["components"] = string_list(channel.components);
+  d["type"] = py::str(scalar_type_name(channel.type));
+  d["role"] = py::str(attribute_role_name(channel.role));
+  d["values"] = to_numpy(std::move(channel.values));
+  return d;
+}
+
+std::string key_of(const std::string& parent, const std::string& key) {
+  return parent + "['" + key + "']";
+}
+
+std::string item_of(const std::string& parent, std::size_t i) {
+  return parent + "[" + std::to_string(i) + "]";
+}
+
+// `object` as a dict whose keys are all in `allowed`; ValueError naming the first other key.
+py::dict checked_dict(const py::handle& object, const std::string& name, std::initializer_list<const char*> allowed) {
+  if (!py::isinstance<py::dict>(object))
+    throw py::value_error(name + " must be a dict, got " +
+                          std::string(py::str(py::type::handle_of(object).attr("__name__"))));
+  const py::dict d = py::reinterpret_borrow<py::dict>(object);
+  for (const auto& [key, value] : d) {
+    const std::string k = py::str(key);
+    bool known = false;
+    std::string keys;
+    for (const char* a : allowed) {
+      known = known || k == a;
+      keys += (keys.empty() ? "" : ", ") + std::string(a);
+    }
+    if (!known) throw py::value_error(name + ": unknown key '" + k + "' (the keys are " + keys + ")");
+  }
+  return d;
+}
+
+// A sequence of items (not a str), or an empty one for a missing key or None.
+std::vector<py::handle> sequence_items(const py::dict& d, const char* key, const std::string& name) {
+  std::vector<py::handle> items;
+  if (!d.contains(key) || d[key].is_none()) return items;
+  const py::object value = d[key];
+  if (py::isinstance<py::str>(value) || !py::isinstance<py::sequence>(value))
+    throw py::value_error(name + " must be a list");
+  for (const py::handle item : value) items.push_back(item);
+  return items;
+}
+
+std::string str_value(const py::dict& d, const char* key, const std::string& name) {
+  if (!d.contains(key)) throw py::value_error(name + " is missing");
+  const py::object value = d[key];
+  if (!py::isinstance<py::str>(value)) throw py::value_error(name + " must be a str");
+  return value.cast<std::string>();
+}
+
+// The enumerator whose name (`name_of`) is `text`; ValueError listing the names otherwise.
+template <typename Enum>
+Enum named_enum(const std::string& text, int count, const char* (*name_of)(Enum), const std::string& name) {
+  std::string names;
+  for (int i = 0; i < count; ++i) {
+    const auto e = static_cast<Enum>(i);
+    if (text == name_of(e)) return e;
+    names += (names.empty() ? "" : ", ") + std::string(name_of(e));
+  }
+  throw py::value_error(name + ": '" + text + "' is not one of " + names);
+}
+
+AttributeChannel channel_from_python(const py::handle& object, const std::string& name, bool corner) {
+  const py::dict d = corner ? checked_dict(object, name, {"name", "components", "type", "role", "values", "corners"})
+                            : checked_dict(object, name, {"name", "components", "type", "role", "values"});
+  AttributeChannel c;
+  c.name = str_value(d, "name", key_of(name, "name"));
+  if (d.contains("type")) c.type = named_enum(str_value(d, "type", key_of(name, "type")), kScalarTypes,
+                                              &scalar_type_name, key_of(name, "type"));
+  if (d.contains("role")) c.role = named_enum(str_value(d, "role", key_of(name, "role")), kRoles,
+                                              &attribute_role_name, key_of(name, "role"));
+
+  const std::string values_name = key_of(name, "values");
+  if (!d.contains("values")) throw py::value_error(values_name + " is missing");
+  const DoubleArray values = DoubleArray::ensure(as_numeric_array(d["values"], values_name.c_str()));
+  if (!values) throw py::error_already_set();
+  if (values.ndim() != 1 && values.ndim() != 2)
+    throw py::value_error(values_name + " must have shape (rows, components), got " +
+                          std::string(py::str(py::getattr(values, "shape"))));
+  const py::ssize_t rows = values.shape(0), width = values.ndim() == 2 ? values.shape(1) : 1;
+  if (width == 0) throw py::value_error(values_name + " has no columns");
+  c.values = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(values.data(),
+                                                                                                      rows, width);
+  if (is_integer_type(c.type)) {
+    for (Eigen::Index i = 0; i < c.values.size(); ++i) {
+      const double v = c.values.data()[i];
+      if (to_scalar_type(v, c.type) != v)
+        throw py::value_error(values_name + " has " + py::str(py::float_(v)).cast<std::string>() + " (row " +
+                              std::to_string(i / width) + "), not an integer that " +
+                              scalar_type_name(c.type) + " holds");
+    }
+  }
+
+  const std::string components_name = key_of(name, "components");
+  if (d.contains("components") && !d["components"].is_none()) {
+    c.components = string_lines(d["components"], components_name.c_str());
+    if (static_cast<py::ssize_t>(c.components.size()) != width)
+      throw py::value_error(components_name + " names " + std::to_string(c.components.size()) + " components for " +
+                            std::to_string(width) + " columns of values");
+  } else if (width == 1) {
+    c.components = {c.name};
+  } else {
+    throw py::value_error(components_name + " is missing (needed for " + std::to_string(width) + " columns)");
+  }
+  return c;
+}
+
+CornerChannel corner_from_python(const py::handle& object, const std::string& name, std::int64_t num_faces) {
+  CornerChannel c;
+  c.channel = channel_from_python(object, name, true);
+  const py::dict d = py::reinterpret_borrow<py::dict>(object);
+  const std::string corners_name = key_of(name, "corners");
+  if (!d.contains("corners")) throw py::value_error(corners_name + " is missing");
+  const py::array a = as_numeric_array(d["corners"], corners_name.c_str());
+  if (a.dtype().kind() == 'f') {
+    const DoubleArray f = DoubleArray::ensure(a);
+    for (py::ssize_t i = 0; i < f.size(); ++i)
+      if (f.data()[i] != std::floor(f.data()[i]))
+        throw py::value_error(corners_name + " must hold row indices (integers), got " + std::to_string(f.data()[i]));
+  }
+  const Int64Array corners = Int64Array::ensure(a);
+  if (!corners) throw py::error_already_set();
+  if (corners.ndim() != 2 || corners.shape(1) != 3 || corners.shape(0) != num_faces)
+    throw py::value_error(corners_name + " must have shape (" + std::to_string(num_faces) + ", 3) (one row per face), got " +
+                          std::string(py::str(py::getattr(corners, "shape"))));
+  const std::int64_t rows = c.channel.rows();
+  for (py::ssize_t i = 0; i < corners.size(); ++i)
+    if (corners.data()[i] < -1 || corners.data()[i] >= rows)
+      throw py::value_error(corners_name + " has " + std::to_string(corners.data()[i]) + " (row " +
+                            std::to_string(i / 3) + ") outside -1.." + std::to_string(rows - 1) +
+                            " (the rows of its values; -1: none)");
+  c.corners = Eigen::Map<const Eigen::Matrix<std::int64_t, Eigen::Dynamic, 3, Eigen::RowMajor>>(corners.data(),
+                                                                                                corners.shape(0), 3)
+                  .cast<std::int32_t>();
+  return c;
+}
+
+}  // namespace
+
+py::dict attributes_to_python(MeshAttributes&& attributes) {
+  py::dict d;
+  py::list vertex, corner, face;
+  for (AttributeChannel& c : attributes.vertex) vertex.append(channel_to_python(std::move(c)));
+  for (CornerChannel& c : attributes.corner) {
+    py::dict channel = channel_to_python(std::move(c.channel));
+    channel["corners"] = to_numpy(std::move(c.corners));
+    corner.append(channel);
+  }
+  for (AttributeChannel& c : attributes.face) face.append(channel_to_python(std::move(c)));
+  d["vertex"] = vertex;
+  d["corner"] = corner;
+  d["face"] = face;
+  d["materials"] = string_list(attributes.materials);
+  d["groups"] = string_list(attributes.groups);
+  d["objects"] = string_list(attributes.objects);
+  d["material_libraries"] = string_list(attributes.material_libraries);
+  return d;
+}
+
+MeshAttributes attributes_from_python(const py::handle& object, std::int64_t num_vertices, std::int64_t num_faces,
+                                      const char* name) {
+  MeshAttributes attributes;
+  if (object.is_none()) return attributes;
+  const std::string top = name;
+  const py::dict d = checked_dict(
+      object, top, {"vertex", "corner", "face", "materials", "groups", "objects", "material_libraries"});
+  const auto channels = [&](const char* key) {
+    std::vector<py::handle> items = sequence_items(d, key, key_of(top, key));
+    return items;
+  };
+  std::size_t i = 0;
+  for (const py::handle item : channels("vertex"))
+    attributes.vertex.push_back(channel_from_python(item, item_of(key_of(top, "vertex"), i++), false));
+  i = 0;
+  for (const py::handle item : channels("corner"))
+    attributes.corner.push_back(corner_from_python(item, item_of(key_of(top, "corner"), i++), num_faces));
+  i = 0;
+  for (const py::handle item : channels("face"))
+    attributes.face.push_back(channel_from_python(item, item_of(key_of(top, "face"), i++), false));
+  const auto names = [&](const char* key) {
+    if (!d.contains(key)) return std::vector<std::string>();
+    return string_lines(d[key], key_of(top, key).c_str());
+  };
+  attributes.materials = names("materials");
+  attributes.groups = names("groups");
+  attributes.objects = names("objects");
+  attributes.material_libraries = names("material_libraries");
+  try {
+    attributes.validate(num_vertices, num_faces);
+  } catch (const std::invalid_argument& e) {
+    throw py::value_error(e.what());
+  }
+  return attributes;
 }
 
 py::object to_python(const nlohmann::json& j) {

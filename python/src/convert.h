@@ -71,6 +71,21 @@ py::array to_numpy(Matrix&& matrix) {
 /// (V, F) of `mesh` as numpy arrays, without copies.
 py::tuple mesh_tuple(Mesh&& mesh);
 
+/// MeshAttributes as the Python dict the module uses (vertexflow.MeshAttributes): {"vertex": [channel],
+/// "corner": [channel with "corners"], "face": [channel], "materials", "groups", "objects",
+/// "material_libraries": [str]}, each channel {"name", "components", "type", "role", "values"}
+/// with values a (rows, width) float64 array and corners an (m, 3) int32 array. Moves the
+/// matrices into the arrays (no copies). The glTF document (MeshAttributes::gltf) is left out:
+/// it has no Python form.
+py::dict attributes_to_python(MeshAttributes&& attributes);
+
+/// The dict (or None: no attributes) as MeshAttributes for a mesh of `num_vertices` and
+/// `num_faces`: every key checked (unknown keys, missing ones, shapes, types, roles, integer
+/// values in their type's range), then MeshAttributes::validate. ValueError naming the key
+/// ("attributes['corner'][0]['values']: ...") or, from validate, the channel.
+MeshAttributes attributes_from_python(const py::handle& object, std::int64_t num_vertices, std::int64_t num_faces,
+                                      const char* name = "attributes");
+
 /// JSON as Python values: objects as dicts, arrays as lists, null as None.
 py::object to_python(const nlohmann::json& j);
 

@@ -34,13 +34,19 @@ std::optional<ReferenceSurface> reference_from(const py::object& reference) {
   return ReferenceSurface(std::move(dense.V), std::move(dense.F));
 }
 
+// (V_out[, F_out][, attributes_out], report): F_out with the option that changes the faces,
+// attributes_out when the caller gave attributes (re-sampled where vertices moved).
 py::tuple py_enhance(const py::handle& V, const py::handle& F, const py::dict& given, const py::object& reference,
-                     const py::object& provenance, int threads, const py::object& progress) {
+                     const py::object& provenance, const py::object& attributes, int threads,
+                     const py::object& progress) {
   const EnhanceOptions options = enhance_options_from(given, "enhance");
   check_threads(threads);
   Mesh mesh = to_mesh(V, F);
   // Smooth mode reads the input's provenance from its comments, as the CLI's does from the file.
   mesh.comments = string_lines(provenance, "provenance");
+  // Seams and label boundaries are creases, and the channels are re-sampled, as for the CLI's
+  // input (enhance.h).
+  mesh.attributes = attributes_from_python(attributes, mesh.num_vertices(), mesh.num_faces());
   const bool has_reference = !reference.is_none();
   validate_enhance_options(options, has_reference, mesh.num_vertices(), OptionNaming::Python);
   const std::optional<ReferenceSurface> dense = reference_from(reference);
@@ -53,9 +59,12 @@ py::tuple py_enhance(const py::handle& V, const py::handle& F, const py::dict& g
 
   nlohmann::json report = std::move(result.report);
   report["warnings"] = result.warnings;
-  py::array V_out = to_numpy(std::move(result.mesh.V));
-  if (options.edge_flips) return py::make_tuple(V_out, to_numpy(std::move(result.mesh.F)), to_python(report));
-  return py::make_tuple(V_out, to_python(report));
+  py::list out;
+  out.append(to_numpy(std::move(result.mesh.V)));
+  if (options.edge_flips) out.append(to_numpy(std::move(result.mesh.F)));
+  if (!attributes.is_none()) out.append(attributes_to_python(std::move(result.mesh.attributes)));
+  out.append(to_python(report));
+  return py::tuple(out);
 }
 
 // Every option's value (enhance_options_json) after the checks enhance makes for a run with or
@@ -145,8 +154,8 @@ void register_enhance(py::module_& m) {
   m.def("_enhance_mode_table", &enhance_mode_table, "Which options choose each mode: {name, reference, options}.");
   m.attr("_FACES_OPTION") = faces_option();
   m.def("_enhance", &py_enhance, py::arg("V"), py::arg("F"), py::arg("options"), py::arg("reference") = py::none(),
-        py::arg("provenance") = py::none(), py::arg("threads") = 0, py::arg("progress") = py::none(),
-        "vertexflow.enhance's work: options is {keyword: value} of the keywords given.");
+        py::arg("provenance") = py::none(), py::arg("attributes") = py::none(), py::arg("threads") = 0,
+        py::arg("progress") = py::none(), "vertexflow.enhance's work: options is {keyword: value} of the keywords given.");
   m.def("_enhance_options", &py_enhance_options, py::arg("options"), py::arg("has_reference") = false,
         py::arg("naming") = "python", "vertexflow.enhance_options's work.");
   m.def("_time_vertex_flow", &py_time_enhance, py::arg("V"), py::arg("F"), py::arg("repeats") = 1,

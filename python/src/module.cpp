@@ -7,7 +7,9 @@ PYBIND11_MODULE(_core, m) {
   m.doc() = R"doc(vertexflow: feature enhancement of triangle meshes by vertex flow (Ji et al. 2011).
 
 Meshes are numpy arrays, libigl-style: V is (n, 3) float64 (other dtypes and orders are converted;
-C-contiguous float64 is used as it is), F is (m, 3) integer vertex indices. Bad arrays and options
+C-contiguous float64 is used as it is), F is (m, 3) integer vertex indices. What a mesh carries
+besides (texture coordinates, normals, colours, labels, PLY properties) is a dict, MeshAttributes:
+read_mesh(path, attributes=True) returns it, write_mesh and enhance take it. Bad arrays and options
 raise ValueError, file problems OSError, each with the library's message. Heavy calls release the
 GIL and take threads=0 (all cores) or a thread count; results do not depend on it. Nothing is
 printed: pass progress=callable to hear about progress.)doc";

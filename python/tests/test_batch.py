@@ -114,10 +114,16 @@ def test_enhance_file_reports_failures_without_raising(messy, tmp_path):
     assert row["status"] == "failed"  # never overwrites its input
     row = vertexflow.enhance_file(DATA / "spot.obj", tmp_path / "spot.obj", lam=0.5)
     assert row["status"] == "done"
-    V, F = vertexflow.read_mesh(DATA / "spot.obj")
-    V_out, _ = vertexflow.enhance(V, F, lam=0.5)
-    V_file, _ = vertexflow.read_mesh(tmp_path / "spot.obj")
+    # What enhance_file wrote is what enhance makes of the mesh as the CLI reads it: its face list and
+    # its attributes (spot's texture seams are creases), re-sampled in the result.
+    V, F, attributes = vertexflow.read_mesh(DATA / "spot.obj", attributes=True, keep_faces=True)
+    V_out, attributes_out, _ = vertexflow.enhance(V, F, lam=0.5, attributes=attributes)
+    V_file, F_file, attributes_file = vertexflow.read_mesh(tmp_path / "spot.obj", attributes=True, keep_faces=True)
     assert np.array_equal(V_file, V_out)  # OBJ writes 17 significant digits: exact
+    assert np.array_equal(F_file, F)
+    uv_out, uv_file = attributes_out["corner"][0], attributes_file["corner"][0]
+    assert uv_out["name"] == uv_file["name"] == "uv"
+    assert np.array_equal(uv_file["values"], uv_out["values"]) and np.array_equal(uv_file["corners"], uv_out["corners"])
 
 
 # --- reference mode over (coarse, dense) pairs: the level-of-detail pipeline -----------------------

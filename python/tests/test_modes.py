@@ -39,15 +39,18 @@ def test_cli_python_enhance_file_and_batch_write_the_same_bytes(tmp_path, case):
     run_cli("-q", "enhance", source, outputs["cli"], *cli_flags(options),
             *(["--reference", reference] if reference else []))
 
-    # enhance + write_mesh, with the comments the CLI writes: the input's and the run's line.
-    V, F, comments = vertexflow.read_mesh(source, comments=True)
-    result = vertexflow.enhance(V, F, reference=reference, provenance=comments, threads=1, **options)
+    # enhance + write_mesh, with what the CLI reads and writes: the file's face list, its attributes
+    # (re-sampled by the engine), and the comments: the input's and the run's line.
+    V, F, comments, attributes = vertexflow.read_mesh(source, comments=True, attributes=True, keep_faces=True)
+    result = vertexflow.enhance(V, F, reference=reference, provenance=comments, attributes=attributes, threads=1,
+                                **options)
     faces_change = options.get(vertexflow._options.FACES_OPTION, False)
-    assert len(result) == (3 if faces_change else 2)
-    V_out, F_out, report = result if faces_change else (result[0], F, result[1])
+    assert len(result) == (4 if faces_change else 3)
+    V_out, F_out, attributes_out, report = result if faces_change else (result[0], F, *result[1:])
     assert report["method"] == mode and report["warnings"] == []
     assert V_out.shape == V.shape and F_out.shape == F.shape
-    vertexflow.write_mesh(outputs["python"], V_out, F_out, comments=comments + [report["provenance"]])
+    vertexflow.write_mesh(outputs["python"], V_out, F_out, comments=comments + [report["provenance"]],
+                          attributes=attributes_out)
 
     # enhance_file, and batch: its input list, or in a reference mode a manifest row.
     row = vertexflow.enhance_file(source, outputs["file"], reference=reference, **options)
@@ -63,7 +66,8 @@ def test_cli_python_enhance_file_and_batch_write_the_same_bytes(tmp_path, case):
     assert len(set(hashes.values())) == 1, hashes
     if reference is not None:
         # A reference given as arrays: the same vertices; the provenance line names it '?'.
-        arrays = vertexflow.enhance(V, F, reference=vertexflow.read_mesh(reference), provenance=comments, **options)
+        arrays = vertexflow.enhance(V, F, reference=vertexflow.read_mesh(reference), provenance=comments,
+                                    attributes=attributes, **options)
         assert arrays[0].tobytes() == V_out.tobytes()
         assert arrays[-1]["provenance"] == report["provenance"].replace(f" {reference.name} ", " ? ")
     # The flow, the fit and the mask moved vertices; edge flips changed faces.

@@ -30,9 +30,11 @@ def read(name):
 def test_enhance_matches_cli_bit_for_bit(tmp_path, name, cli_args, kwargs):
     out = tmp_path / "cli.ply"  # PLY keeps float64 exactly
     run_cli("-q", "enhance", DATA / name, out, *cli_args)
-    V_cli, F_cli = vertexflow.read_mesh(out)
-    V, F = read(name)
-    V_out, report = vertexflow.enhance(V, F, **kwargs)
+    V_cli, F_cli = vertexflow.read_mesh(out, keep_faces=True)
+    # The input as the CLI reads it: its face list, and its attributes (spot's texture seams are
+    # creases for the flow); the result's attributes are re-sampled (test_attributes.py).
+    V, F, attributes = vertexflow.read_mesh(DATA / name, attributes=True, keep_faces=True)
+    V_out, _, report = vertexflow.enhance(V, F, attributes=attributes, **kwargs)
     assert V_out.dtype == np.float64 and V_out.shape == V.shape
     assert V_out.tobytes() == V_cli.tobytes()
     assert np.array_equal(F, F_cli)

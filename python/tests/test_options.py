@@ -170,7 +170,8 @@ def test_stub_lists_every_public_name():
 def test_stub_has_every_option_with_the_tables_default():
     _, functions = stub_functions()
     faces = vertexflow._options.FACES_OPTION
-    assert len(functions["enhance"]) == 3  # overloads: faces unchanged, changed, and either (a bool)
+    # Overloads: faces unchanged and changed, without and with attributes, and any (a bool, a dict or None).
+    assert len(functions["enhance"]) == 5
     for name in ("enhance", "enhance_file", "batch", "enhance_options"):
         runtime = [p for p in inspect.signature(getattr(vertexflow, name)).parameters.values()]
         for node in functions[name]:

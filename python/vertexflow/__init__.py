@@ -5,7 +5,9 @@
 import inspect as _inspect
 import os as _os
 from typing import Any as _Any, Callable as _Callable, Iterable as _Iterable, Literal as _Literal
-from typing import Sequence as _Sequence
+from typing import NotRequired as _NotRequired, Sequence as _Sequence, TypedDict as _TypedDict
+
+import numpy as _np
 
 from . import _core
 from ._core import *  # noqa: F401,F403  read_mesh, write_mesh, compare, render, ... (python/src/*.cpp)
@@ -16,6 +18,67 @@ from ._options import front_end as _front_end
 __doc__ = _core.__doc__
 
 _Path = str | _os.PathLike
+
+
+class AttributeChannel(_TypedDict):
+    """One channel of a mesh's attributes (include/vertexflow/attributes.h), as read_mesh(...,
+    attributes=True) and enhance(..., attributes=...) return it and write_mesh and enhance take it.
+
+    name: "uv", "normal", "color", "material", or a PLY property's own name.
+    components: the file's component names, in file order (["s", "t"], ["red", "green", "blue"]).
+      May be left out for a one-column channel (then [name]).
+    type: the scalar type the file has and a writer writes: "int8", "uint8", "int16", "uint16",
+      "int32", "uint32", "float32" or "float64" (default). Integer types' values must be integers
+      in the type's range.
+    role: how the channel follows a moved vertex in enhance: "generic" (default; interpolated),
+      "color" (interpolated, rounded), "texcoord" (interpolated in the vertex's own chart; seams
+      are creases), "normal" (recomputed), "label" (kept), "weights" (interpolated, renormalised).
+    values: (rows, len(components)) float64 array (a 1-D array is one column); every type's values
+      are exact in float64. Rows are the mesh's vertices (a vertex channel), faces (a face
+      channel), or the channel's own table of values (a corner channel).
+    """
+
+    name: str
+    components: _NotRequired[list[str]]
+    type: _NotRequired[str]
+    role: _NotRequired[str]
+    values: _np.ndarray
+
+
+class CornerChannel(AttributeChannel):
+    """A channel whose values belong to face corners (OBJ `vt`/`vn` with their own indices, PLY face
+    `texcoord` lists): corners, an (m, 3) int32 array with one row per face, holds the row of values
+    each corner uses, -1 where the corner has none. A seam is where a vertex's corners use
+    different rows."""
+
+    corners: _np.ndarray
+
+
+class MeshAttributes(_TypedDict, total=False):
+    """What a mesh carries besides V and F (include/vertexflow/attributes.h, docs/attributes.md):
+    read_mesh(path, attributes=True) returns it with every key; write_mesh, enhance take it, with
+    missing keys as empty lists. Bad dicts raise ValueError naming the key.
+
+    vertex: channels with one row per vertex (PLY vertex properties after x y z, colours).
+    corner: CornerChannels (texture coordinates and normals per face corner).
+    face: channels with one row per face (PLY face properties; OBJ "material", "group",
+      "object" labels, int32 indices into the name tables below, -1 for none, and "smoothing").
+    materials, groups, objects: the names the OBJ labels index, in first-use order.
+    material_libraries: OBJ `mtllib` file names, in file order.
+
+    A glTF file's document (materials, textures, nodes, ...) is not part of the dict: a mesh read
+    from glTF and written from Python is written as one primitive. enhance_file, batch and the
+    CLI carry the document through.
+    """
+
+    vertex: list[AttributeChannel]
+    corner: list[CornerChannel]
+    face: list[AttributeChannel]
+    materials: list[str]
+    groups: list[str]
+    objects: list[str]
+    material_libraries: list[str]
+
 
 
 def _positional(name, default=_inspect.Parameter.empty, annotation=_inspect.Parameter.empty):
@@ -31,10 +94,11 @@ enhance = _front_end(
     [_positional("V"), _positional("F"),
      _keyword("reference", None, tuple | _Path | None),
      _keyword("provenance", None, _Sequence[str] | None),
+     _keyword("attributes", None, MeshAttributes | None),
      _keyword("threads", 0, int),
      _keyword("progress", None, _Callable[[str], _Any] | None)],
-    lambda options, V, F, reference, provenance, threads, progress: _core._enhance(
-        V, F, options, reference, provenance, threads, progress),
+    lambda options, V, F, reference, provenance, attributes, threads, progress: _core._enhance(
+        V, F, options, reference, provenance, attributes, threads, progress),
     """
 Enhances the mesh (V, F) with the engine of `vertexflow enhance` (enhance.h), in any of its modes,
 then flips edges if asked.
@@ -43,8 +107,21 @@ Returns (V_out, report). V_out, (n, 3) float64, is bit for bit what `vertexflow 
 the same options. report is the engine's report as a dict: "method" (the mode), "options", what
 the method measured (solver, guard, fit, ...), "seconds", "provenance" (the line the CLI appends
 to the output's comments: write_mesh(path, V_out, F, comments=provenance + [report["provenance"]])
-writes the CLI's bytes) and "warnings". The one option that changes the faces (edge flips) makes
-it return (V_out, F_out, report); otherwise the faces are F's.
+writes the CLI's bytes for an input without attributes) and "warnings". The one option that
+changes the faces (edge flips) makes it return (V_out, F_out, report); otherwise the faces are F's.
+
+With attributes (a MeshAttributes dict, as read_mesh(path, attributes=True) returns), the engine
+gets them as the CLI gets its input's: texture seams and material and other label boundaries are
+creases, and each moved vertex's channels are re-sampled where it lands. The result then also
+holds the re-sampled attributes, before the report: (V_out, attributes_out, report), or
+(V_out, F_out, attributes_out, report) with edge flips; report["attributes"] says how many were
+re-sampled and how far. The CLI's bytes, for any input:
+
+    V, F, comments, attributes = read_mesh(path, comments=True, attributes=True, keep_faces=True)
+    V_out, attributes_out, report = enhance(V, F, provenance=comments, attributes=attributes)
+    write_mesh(out, V_out, F, comments=comments + [report["provenance"]], attributes=attributes_out)
+
+(keep_faces=True reads the face list as `vertexflow enhance` does; enhance_file does all of it.)
 
 reference: the dense mesh of the true surface, for the reference modes: a pair (V_ref, F_ref), or
   a mesh file's path, read as `--reference` reads it (its file name goes into the provenance
@@ -52,6 +129,8 @@ reference: the dense mesh of the true surface, for the reference modes: a pair (
 provenance: the input's comment lines (read_mesh(path, comments=True)). Smooth mode holds an input
   whose provenance records an earlier fit, which placed it off its surface, as the CLI does
   (report["fit"]["held_as_fitted"], ["fitted_by"]).
+attributes: the input's attributes (MeshAttributes) or None; see above. ValueError naming the key
+  of a bad dict (or the channel whose rows do not match V or F).
 threads: TBB threads, 0 for all cores; the result does not depend on it.
 progress: progress(str) is called before and after the work.
 
