@@ -1,6 +1,7 @@
 // Writers for OBJ, PLY, OFF and STL, optionally gzip-compressed, with atomic replacement:
 // bytes go to a temporary file beside the target (unnamed where the file system allows, so a
 // killed process leaves nothing behind), which is renamed over it only when complete.
+#include "gltf.h"
 #include "io_internal.h"
 
 #include <zlib.h>
@@ -429,6 +430,8 @@ Written written_channels(const Mesh& mesh, MeshFormat format, const WriteOptions
       break;
     case MeshFormat::Stl:
       break;
+    case MeshFormat::Gltf:  // gltf.cpp decides (the document's channels, or a fresh document's)
+      break;
   }
   return w;
 }
@@ -761,11 +764,15 @@ void write_mesh(const std::filesystem::path& path, const Mesh& mesh, const Write
     case MeshFormat::Stl:
       io_detail::write_stl(out, mesh, options);
       break;
+    case MeshFormat::Gltf:
+      out.buffer() += io_detail::write_gltf(path, mesh, lowercase_extension(path) == ".glb");
+      break;
   }
   out.commit();
 }
 
 std::vector<std::string> attributes_not_written(const Mesh& mesh, MeshFormat format, const WriteOptions& options) {
+  if (format == MeshFormat::Gltf) return io_detail::gltf_attributes_not_written(mesh);
   const io_detail::Written w = io_detail::written_channels(mesh, format, options);
   const MeshAttributes& a = mesh.attributes;
   std::vector<std::string> out;
