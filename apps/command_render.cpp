@@ -1,6 +1,7 @@
 // `vertexflow render IN OUT.png [--color ...] [--wireframe] [--view ...] [--size WxH]
 // [--shading smooth|flat|exaggerated] [--exaggeration A --scales N --sigma S --weights K --light X,Y,Z]
-// [--frame-from MESH | --frame BOX] [--before MESH]`: a headless picture of a mesh (render.h).
+// [--frame-from MESH | --frame BOX] [--before MESH] [--texture none|checker --checker-squares N]`:
+// a headless picture of a mesh (render.h).
 // --flat and --smooth are kept as aliases of --shading flat and --shading smooth.
 // The colour range is printed on stdout (and drawn, labelled, in the image's colour bar).
 #include "camera_options.h"
@@ -19,6 +20,7 @@ struct RenderCommandOptions {
   std::string input;
   std::string output;
   std::string color = "none";
+  std::string texture = "none";
   std::string before;
   CameraCliOptions camera;
   std::optional<double> color_limit;
@@ -50,6 +52,13 @@ void register_render_command(CLI::App& app, const GlobalOptions& global) {
                    "Colour by mean or Gaussian curvature (red positive, blue negative), triangle quality 2r/R "
                    "(red = poor) or displacement from --before (white 0 .. red large)")
       ->check(CLI::IsMember({"none", "mean", "gauss", "quality", "displacement"}));
+  // Checked in the callback rather than by CLI11, whose messages take two lines.
+  command->add_option("--texture", o->texture,
+                      "none (default), or checker: a checkerboard laid on the mesh's texture coordinates (the first "
+                      "texcoord channel, e.g. an OBJ's vt), dark and light grey over the shading and colour, so that "
+                      "a texture that swims or stretches shows");
+  auto* squares = command->add_option("--checker-squares", o->render.checker_squares,
+                                      "--texture checker: squares per unit of texture coordinate (1..256, default 16)");
   command->add_option("--before", o->before,
                       "The mesh before the flow (same vertices and order), for --color displacement");
   command->add_flag("--wireframe", o->wireframe, "Draw the edges on the surface");
@@ -97,7 +106,7 @@ void register_render_command(CLI::App& app, const GlobalOptions& global) {
   command->add_flag("--no-colorbar", o->no_color_bar, "Leave out the colour bar and its labels");
   command->add_flag("--json", o->json, "Print the colour range, camera frame and timings as JSON on stdout");
   command->add_flag("--force", o->force, "Allow OUT to be one of the input files");
-  command->callback([o, &global] {
+  command->callback([o, squares, &global] {
     if (lowercase_extension(o->output) != ".png") throw IoError(o->output + ": the output must be a .png file");
     check_outputs({o->input, o->before, o->camera.frame_from},
                   {{o->output, /*mesh=*/false, /*may_replace_input=*/true}}, o->force);
@@ -109,6 +118,13 @@ void register_render_command(CLI::App& app, const GlobalOptions& global) {
                                                        {"quality", RenderColor::Quality},
                                                        {"displacement", RenderColor::Displacement}};
     options.color = colors.at(o->color);
+    if (o->texture != "none" && o->texture != "checker")
+      throw std::invalid_argument("--texture " + o->texture + ": expected none or checker");
+    if (options.checker_squares < 1 || options.checker_squares > 256)
+      throw std::invalid_argument(fmt::format("--checker-squares {}: expected 1..256", options.checker_squares));
+    options.texture = o->texture == "checker" ? RenderTexture::Checker : RenderTexture::None;
+    if (squares->count() > 0 && options.texture != RenderTexture::Checker && !global.quiet)
+      fmt::print(stderr, "vertexflow: warning: --checker-squares is only used with --texture checker\n");
     options.shading = o->flat || o->shading == "flat" ? RenderShading::Flat
                       : o->shading == "exaggerated"   ? RenderShading::Exaggerated
                                                       : RenderShading::Smooth;

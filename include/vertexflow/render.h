@@ -71,6 +71,16 @@ enum class RenderColor {
   Displacement,
 };
 
+/// A texture laid over the surface through its texture coordinates (the first TexCoord corner
+/// or vertex channel, attributes.h), to show how a method moved them.
+enum class RenderTexture {
+  None,
+  /// A procedural checkerboard in UV space, RenderOptions::checker_squares squares per unit,
+  /// dark and light grey, multiplied into the surface colour: a texture that swims or stretches
+  /// shows as bent or uneven squares.
+  Checker,
+};
+
 enum class RenderShading {
   /// Vertex normals (curvature.h's vertex_normals, Max 1999 weights), lit per vertex and
   /// interpolated across each triangle (Gouraud).
@@ -99,6 +109,10 @@ struct RenderOptions {
   double azimuth_degrees = 30;
   double elevation_degrees = 20;
   RenderColor color = RenderColor::None;
+  /// RenderTexture::Checker needs texture coordinates (render_mesh throws without them).
+  RenderTexture texture = RenderTexture::None;
+  /// Checker squares per unit of texture coordinate, in [1, 256].
+  int checker_squares = 16;
   RenderShading shading = RenderShading::Smooth;
   /// Draw every edge on top of the surface (hidden edges stay hidden), to show the vertex
   /// distribution.

@@ -3,8 +3,8 @@
 // which is all a shaded mesh with a wireframe needs. Multisampling goes through a framebuffer
 // object resolved into OSMesa's buffer. The legend's text is drawn with FreeType; the colour
 // bar itself is a few filled rectangles written straight into the image. PNG via libpng.
-// About 600 lines in one file: the scene, the legend and the output share one OSMesa context and
-// its GL state, whose set-up and tear-down order matters.
+// About 800 lines in one file: the scene, its checker texture, the legend and the output share
+// one OSMesa context and its GL state, whose set-up and tear-down order matters.
 #include "vertexflow/render.h"
 
 #include "vertexflow/colormap.h"
@@ -137,6 +137,7 @@ struct DrawArrays {
   std::vector<float> positions;       // 3 per render vertex
   std::vector<float> normals;         // 3 per render vertex
   std::vector<std::uint8_t> rgba;     // 4 per render vertex
+  std::vector<float> uvs;             // 2 per render vertex, in checker texture periods; empty: no texture
   bool indexed = false;               // true: render vertices are mesh vertices, draw F
   std::vector<float> mesh_positions;  // 3 per mesh vertex, for the wireframe
 };
@@ -145,15 +146,57 @@ void put3(std::vector<float>& out, std::size_t slot, const Eigen::Vector3d& v) {
   for (int k = 0; k < 3; ++k) out[3 * slot + k] = static_cast<float>(v[k]);
 }
 
+// The texture coordinates a checker render uses: the first TexCoord corner channel with two
+// or more components, else the first such vertex channel (render.h).
+struct TexCoords {
+  const CornerChannel* corner = nullptr;
+  const AttributeChannel* vertex = nullptr;
+  [[nodiscard]] bool empty() const { return !corner && !vertex; }
+};
+
+TexCoords find_texcoords(const Mesh& mesh) {
+  TexCoords t;
+  for (const CornerChannel& c : mesh.attributes.corner)
+    if (c.channel.role == AttributeRole::TexCoord && c.channel.width() >= 2 && c.corners.rows() == mesh.F.rows()) {
+      t.corner = &c;
+      return t;
+    }
+  for (const AttributeChannel& c : mesh.attributes.vertex)
+    if (c.role == AttributeRole::TexCoord && c.width() >= 2 && c.rows() == mesh.V.rows()) {
+      t.vertex = &c;
+      return t;
+    }
+  return t;
+}
+
+// The checker texture holds 2 x 2 squares (one period), so texture coordinates are scaled by
+// squares / 2. A corner without a value (-1) gets the centre of a light square, so a face
+// without texture coordinates shows plain rather than a stretched pattern.
+Eigen::Vector2d corner_uv(const TexCoords& t, Index f, int k, Index v, int squares) {
+  const double scale = squares / 2.0;
+  if (t.vertex) return scale * Eigen::Vector2d(t.vertex->values(v, 0), t.vertex->values(v, 1));
+  const std::int32_t row = t.corner->corners(f, k);
+  if (row < 0) return {0.25, 0.25};
+  if (row >= t.corner->channel.rows())
+    throw std::invalid_argument(
+        fmt::format("texture coordinate channel '{}': corner {} of face {} indexes row {} of {}",
+                    t.corner->channel.name, k, f, row, t.corner->channel.rows()));
+  return scale * Eigen::Vector2d(t.corner->channel.values(row, 0), t.corner->channel.values(row, 1));
+}
+
 // `shades`: exaggerated shading's per-vertex shades (empty for the lit modes), which scale the
 // vertex colours from white (or the colour map's colour) down to black.
+// `texcoords`: empty unless a texture is drawn.
 DrawArrays build_arrays(const Mesh& mesh, const RenderOptions& options, const ScalarField& field,
-                        const Eigen::VectorXd& shades, const Eigen::Vector3d& centre) {
+                        const Eigen::VectorXd& shades, const Eigen::Vector3d& centre, const TexCoords& texcoords) {
   const auto nv = static_cast<std::size_t>(mesh.V.rows());
   const auto nf = static_cast<std::size_t>(mesh.F.rows());
   const bool flat = options.shading == RenderShading::Flat;
+  const bool textured = !texcoords.empty();
   DrawArrays a;
-  a.indexed = !flat && !field.per_face;
+  // Per-corner texture coordinates differ between a vertex's faces at a seam: 3 render
+  // vertices per face.
+  a.indexed = !flat && !field.per_face && !textured;
   a.mesh_positions.resize(3 * nv);
   for (std::size_t v = 0; v < nv; ++v)
     put3(a.mesh_positions, v, mesh.V.row(static_cast<Index>(v)).transpose() - centre);
@@ -182,11 +225,13 @@ DrawArrays build_arrays(const Mesh& mesh, const RenderOptions& options, const Sc
     }
     return a;
   }
-  // Three render vertices per face: per-face normals (flat) or per-face colours (quality).
+  // Three render vertices per face: per-face normals (flat), per-face colours (quality) or
+  // per-corner texture coordinates.
   const Vertices N = flat ? Vertices() : vertex_normals(mesh.V, mesh.F);
   a.positions.resize(9 * nf);
   a.normals.resize(9 * nf);
   a.rgba.resize(12 * nf);
+  if (textured) a.uvs.resize(6 * nf);
   for (std::size_t f = 0; f < nf; ++f) {
     const auto fi = static_cast<Index>(f);
     Eigen::Vector3d face_n = flat ? face_normal(mesh.V, mesh.F, fi) : Eigen::Vector3d::UnitZ();
@@ -197,6 +242,11 @@ DrawArrays build_arrays(const Mesh& mesh, const RenderOptions& options, const Sc
       std::copy_n(&a.mesh_positions[3 * static_cast<std::size_t>(v)], 3, &a.positions[3 * slot]);
       put3(a.normals, slot, flat ? face_n : Eigen::Vector3d(N.row(v).transpose()));
       color_of(field.per_face ? f : static_cast<std::size_t>(v), static_cast<std::size_t>(v), slot);
+      if (textured) {
+        const Eigen::Vector2d uv = corner_uv(texcoords, fi, k, v, options.checker_squares);
+        a.uvs[2 * slot] = static_cast<float>(uv.x());
+        a.uvs[2 * slot + 1] = static_cast<float>(uv.y());
+      }
     }
   }
   return a;
@@ -281,6 +331,55 @@ class MultisampleTarget {
   int width_, height_;
   GLuint fbo_ = 0;
   GLuint renderbuffers_[2] = {0, 0};
+};
+
+// The checkerboard: one period of 2 x 2 squares, light where the square indices have an even
+// sum, with its mipmaps built here by 2 x 2 box filtering (exact and the same on every
+// driver) rather than by glGenerateMipmap. Trilinear filtering keeps small or receding squares
+// from aliasing into moire; the 128 texels per square keep magnified edges sharp.
+class CheckerTexture {
+ public:
+  static constexpr int kSize = 256;
+  static constexpr std::uint8_t kDark = 89, kLight = 230;  // 0.35 and 0.9 of full intensity
+
+  CheckerTexture() {
+    std::vector<std::uint8_t> level(static_cast<std::size_t>(kSize) * kSize);
+    for (int y = 0; y < kSize; ++y)
+      for (int x = 0; x < kSize; ++x)
+        level[static_cast<std::size_t>(y) * kSize + x] = ((2 * x / kSize + 2 * y / kSize) % 2) ? kDark : kLight;
+    glGenTextures(1, &id_);
+    glBindTexture(GL_TEXTURE_2D, id_);
+    glPixelStorei(GL_UNPACK_ALIGNMENT, 1);
+    int n = kSize;
+    for (int lod = 0;; ++lod) {
+      glTexImage2D(GL_TEXTURE_2D, lod, GL_LUMINANCE8, n, n, 0, GL_LUMINANCE, GL_UNSIGNED_BYTE, level.data());
+      if (n == 1) break;
+      const int half = n / 2;
+      std::vector<std::uint8_t> next(static_cast<std::size_t>(half) * half);
+      for (int y = 0; y < half; ++y)
+        for (int x = 0; x < half; ++x) {
+          const auto at = [&](int dx, int dy) {
+            return unsigned{level[static_cast<std::size_t>(2 * y + dy) * n + 2 * x + dx]};
+          };
+          next[static_cast<std::size_t>(y) * half + x] =
+              static_cast<std::uint8_t>((at(0, 0) + at(1, 0) + at(0, 1) + at(1, 1) + 2) / 4);
+        }
+      level = std::move(next);
+      n = half;
+    }
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_S, GL_REPEAT);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_WRAP_T, GL_REPEAT);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_LINEAR_MIPMAP_LINEAR);
+    glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_LINEAR);
+    // Lit (or exaggerated-shading) colour times the texel: the squares darken the shading.
+    glTexEnvi(GL_TEXTURE_ENV, GL_TEXTURE_ENV_MODE, GL_MODULATE);
+  }
+  CheckerTexture(const CheckerTexture&) = delete;
+  CheckerTexture& operator=(const CheckerTexture&) = delete;
+  ~CheckerTexture() { glDeleteTextures(1, &id_); }
+
+ private:
+  GLuint id_ = 0;
 };
 
 void set_light(GLenum light, const Eigen::Vector3d& direction, float diffuse, float specular) {
@@ -451,6 +550,8 @@ void check_options(const Mesh& mesh, const RenderOptions& options) {
   if (options.shading == RenderShading::Exaggerated &&
       !(options.exaggerated_light.allFinite() && options.exaggerated_light.norm() > 0))
     throw std::invalid_argument("the exaggerated shading light must be a finite non-zero direction");
+  if (options.checker_squares < 1 || options.checker_squares > 256)
+    throw std::invalid_argument(fmt::format("checker squares {} is outside 1..256", options.checker_squares));
 }
 
 }  // namespace
@@ -552,12 +653,19 @@ Image render_mesh(const Mesh& mesh, const RenderOptions& options, RenderInfo* in
     shades = exaggerated_shading(mesh.V, mesh.F, l.x() * view.right + l.y() * view.up + l.z() * view.back,
                                  options.exaggerated);
   }
-  const DrawArrays arrays = build_arrays(mesh, options, field, shades, centre);
+  TexCoords texcoords;
+  if (options.texture == RenderTexture::Checker) {
+    texcoords = find_texcoords(mesh);
+    if (texcoords.empty()) throw std::invalid_argument("render: --texture checker needs texture coordinates");
+  }
+  const DrawArrays arrays = build_arrays(mesh, options, field, shades, centre, texcoords);
   const double prepare_seconds = seconds_since(start);
 
   start = Clock::now();
   OffscreenContext context(width, height);
   MultisampleTarget target(width, height, options.samples);
+  std::optional<CheckerTexture> checker;
+  if (!arrays.uvs.empty()) checker.emplace();
   glViewport(0, 0, width, height);
   const auto& bg = options.background;
   glClearColor(bg[0] / 255.f, bg[1] / 255.f, bg[2] / 255.f, bg[3] / 255.f);
@@ -601,12 +709,19 @@ Image render_mesh(const Mesh& mesh, const RenderOptions& options, RenderInfo* in
     glVertexPointer(3, GL_FLOAT, 0, arrays.positions.data());
     glNormalPointer(GL_FLOAT, 0, arrays.normals.data());
     glColorPointer(4, GL_UNSIGNED_BYTE, 0, arrays.rgba.data());
+    if (checker) {
+      glEnable(GL_TEXTURE_2D);
+      glEnableClientState(GL_TEXTURE_COORD_ARRAY);
+      glTexCoordPointer(2, GL_FLOAT, 0, arrays.uvs.data());
+    }
     if (arrays.indexed)
       glDrawElements(GL_TRIANGLES, static_cast<GLsizei>(3 * mesh.F.rows()), GL_UNSIGNED_INT, mesh.F.data());
     else
       glDrawArrays(GL_TRIANGLES, 0, static_cast<GLsizei>(3 * mesh.F.rows()));
     glDisableClientState(GL_NORMAL_ARRAY);
     glDisableClientState(GL_COLOR_ARRAY);
+    glDisableClientState(GL_TEXTURE_COORD_ARRAY);
+    glDisable(GL_TEXTURE_2D);  // the wireframe is not textured
     glDisable(GL_POLYGON_OFFSET_FILL);
 
     if (options.wireframe) {

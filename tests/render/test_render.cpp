@@ -1,7 +1,8 @@
 // Off-screen rendering: the camera against analytic projections of a sphere (area, centre,
 // shifts by a known translation in every view), colour maps by their hue, the colour bar by its
 // end colours, the wireframe by its exact line colour (hidden edges stay hidden), flat shading
-// by its number of distinct shades, determinism, and the PNG read back with libpng.
+// by its number of distinct shades, the checker texture by its squares and greys, determinism,
+// and the PNG read back with libpng.
 #include "shapes.h"
 #include "test_support.h"
 
@@ -404,6 +405,169 @@ TEST(Render, RejectsBadOptions) {
   EXPECT_NO_THROW(render_mesh(sphere, options));
 }
 
+// ---- Checker texture -----------------------------------------------------------------------
+
+// The unit square [-0.5, 0.5]^2 in z = 0 (facing the front view's camera), n x n quads, with
+// texture coordinates (x + 0.5, y + 0.5) as a vertex channel or, equally, a corner channel.
+Mesh uv_square(int n, bool per_corner) {
+  Mesh square = test::height_field(0.5, n, [](double, double) { return 0.0; });
+  AttributeChannel uv;
+  uv.name = "uv";
+  uv.components = {"u", "v"};
+  uv.role = AttributeRole::TexCoord;
+  uv.values.resize(square.V.rows(), 2);
+  for (Index v = 0; v < square.V.rows(); ++v) uv.values.row(v) << square.V(v, 0) + 0.5, square.V(v, 1) + 0.5;
+  if (!per_corner) {
+    square.attributes.vertex.push_back(std::move(uv));
+    return square;
+  }
+  CornerChannel corners;
+  corners.channel = std::move(uv);
+  corners.corners = square.F;  // one table row per vertex: the same coordinates per corner
+  square.attributes.corner.push_back(std::move(corners));
+  return square;
+}
+
+double luminance(const std::uint8_t* p) {
+  return (p[0] + p[1] + p[2]) / 3.0;
+}
+
+// Dark and light runs of the foreground along image row y (threshold halfway between the row's
+// darkest and lightest foreground pixel), and the mean of the darkest and of the lightest.
+struct Runs {
+  int count = 0;
+  double dark = 0, light = 0;
+};
+
+Runs checker_runs(const Image& image, int y) {
+  double lo = 255, hi = 0;
+  for (int x = 0; x < image.width; ++x)
+    if (!is_background(image.pixel(x, y)))
+      lo = std::min(lo, luminance(image.pixel(x, y))), hi = std::max(hi, luminance(image.pixel(x, y)));
+  Runs r;
+  r.dark = lo, r.light = hi;
+  int previous = -1;  // 0 dark, 1 light, -1 background
+  for (int x = 0; x < image.width; ++x) {
+    const std::uint8_t* p = image.pixel(x, y);
+    const int now = is_background(p) ? -1 : luminance(p) > 0.5 * (lo + hi);
+    if (now >= 0 && now != previous) ++r.count;
+    previous = now;
+  }
+  return r;
+}
+
+TEST(RenderChecker, SquaresAlongARowAndTheirTwoGreys) {
+  const Mesh square = uv_square(8, false);
+  RenderOptions options = small(RenderView::Front);
+  options.samples = 1;
+  options.texture = RenderTexture::Checker;
+  options.checker_squares = 4;
+  RenderInfo info;
+  const Image image = render_mesh(square, options, &info);
+  // Rows through the middle of the second and third rows of squares (v = 0.375 and 0.625),
+  // and a square's column: 4 squares each way, alternating.
+  for (const double v : {0.375, 0.625}) {
+    const int y = static_cast<int>(info.camera.project(Eigen::Vector3d(0, v - 0.5, 0)).y());
+    const Runs runs = checker_runs(image, y);
+    EXPECT_EQ(runs.count, 4) << "row " << y;
+    // Lit colour times 0.35 and 0.9: flat square, one lit colour, so the greys' ratio.
+    EXPECT_NEAR(runs.dark / runs.light, 0.35 / 0.9, 0.02) << runs.dark << " " << runs.light;
+  }
+  // 16 squares per unit: 16 runs.
+  options.checker_squares = 16;
+  const Image fine = render_mesh(square, options, &info);
+  const int y = static_cast<int>(info.camera.project(Eigen::Vector3d(0, 0.5 / 16 - 0.5 + 1.0 / 16, 0)).y());
+  EXPECT_EQ(checker_runs(fine, y).count, 16);
+  // The untextured square is one uniform colour.
+  options.texture = RenderTexture::None;
+  EXPECT_EQ(checker_runs(render_mesh(square, options), y).count, 1);
+}
+
+TEST(RenderChecker, CornerAndVertexCoordinatesGiveTheSamePicture) {
+  RenderOptions options = small(RenderView::Iso);
+  options.texture = RenderTexture::Checker;
+  options.checker_squares = 5;
+  EXPECT_EQ(render_mesh(uv_square(6, true), options).pixels, render_mesh(uv_square(6, false), options).pixels);
+  // Corners without coordinates (-1) draw; a corner past its table is an error.
+  Mesh partial = uv_square(6, true);
+  partial.attributes.corner[0].corners.row(0).setConstant(-1);
+  EXPECT_NO_THROW(render_mesh(partial, options));
+  partial.attributes.corner[0].corners(0, 0) = 1000;
+  EXPECT_THROW(render_mesh(partial, options), std::invalid_argument);
+}
+
+// Per pixel checker / plain: the texel, 0.35 or 0.9 (the lit colour is the same in both).
+struct TexelRatios {
+  double near_dark = 0, near_light = 0;  // fractions of the lit foreground
+};
+
+TexelRatios texel_ratios(const Image& plain, const Image& checker) {
+  long dark = 0, light = 0, n = 0;
+  for (int y = 0; y < plain.height; ++y)
+    for (int x = 0; x < plain.width; ++x) {
+      const std::uint8_t *p = plain.pixel(x, y), *c = checker.pixel(x, y);
+      if (is_background(p) || luminance(p) < 60) continue;
+      const double ratio = luminance(c) / luminance(p);
+      ++n;
+      dark += std::abs(ratio - 0.35) < 0.04;
+      light += std::abs(ratio - 0.9) < 0.04;
+    }
+  return {double(dark) / std::max(1L, n), double(light) / std::max(1L, n)};
+}
+
+TEST(RenderChecker, ModulatesEveryShadingAndColour) {
+  const Mesh spot = read_mesh(test::data_path("spot.obj"));
+  ASSERT_FALSE(spot.attributes.corner.empty());
+  RenderOptions options = small(RenderView::Front);
+  options.width = 640;
+  options.height = 480;
+  options.samples = 1;
+  options.checker_squares = 8;
+  for (const RenderShading shading : {RenderShading::Smooth, RenderShading::Flat, RenderShading::Exaggerated})
+    for (const RenderColor color : {RenderColor::None, RenderColor::Mean, RenderColor::Quality}) {
+      options.shading = shading;
+      options.color = color;
+      options.texture = RenderTexture::None;
+      const Image plain = render_mesh(spot, options);
+      options.texture = RenderTexture::Checker;
+      const Image checker = render_mesh(spot, options);
+      ASSERT_NE(plain.pixels, checker.pixels);
+      // The same coverage (a white highlight of the plain render counts as background there).
+      EXPECT_NEAR(footprint(checker).count, footprint(plain).count, 0.01 * footprint(plain).count);
+      const TexelRatios r = texel_ratios(plain, checker);
+      EXPECT_GT(r.near_dark, 0.3) << static_cast<int>(shading) << " " << static_cast<int>(color);
+      EXPECT_GT(r.near_light, 0.3) << static_cast<int>(shading) << " " << static_cast<int>(color);
+      EXPECT_GT(r.near_dark + r.near_light, 0.85) << static_cast<int>(shading) << " " << static_cast<int>(color);
+      // Deterministic: the same bytes again.
+      EXPECT_EQ(encode_png(render_mesh(spot, options)), encode_png(checker));
+    }
+}
+
+TEST(RenderChecker, NeedsTextureCoordinatesAndASquareCountInRange) {
+  const Mesh sphere = test::icosphere(1.0, 2);
+  RenderOptions options = small();
+  options.texture = RenderTexture::Checker;
+  try {
+    render_mesh(sphere, options);
+    ADD_FAILURE() << "no exception";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "render: --texture checker needs texture coordinates");
+  }
+  // A vertex channel of another role is not texture coordinates.
+  Mesh labelled = sphere;
+  labelled.set_vertex_property("u", Eigen::VectorXd::Zero(sphere.V.rows()));
+  EXPECT_THROW(render_mesh(labelled, options), std::invalid_argument);
+  const Mesh square = uv_square(2, false);
+  for (const int squares : {0, 257, -3}) {
+    options.checker_squares = squares;
+    EXPECT_THROW(render_mesh(square, options), std::invalid_argument) << squares;
+  }
+  options.checker_squares = 256;
+  EXPECT_NO_THROW(render_mesh(square, options));
+  options.checker_squares = 1;
+  EXPECT_NO_THROW(render_mesh(square, options));
+}
+
 // ---- CLI -----------------------------------------------------------------------------------
 
 TEST(RenderCli, WritesAPngAndPrintsTheRange) {
@@ -465,6 +629,38 @@ TEST(RenderCli, DisplacementAgainstTheMeshBefore) {
   EXPECT_EQ(e.exit_code, 1);
   EXPECT_NE(e.err.find("bunny_uniform.off"), std::string::npos) << e.err;
   EXPECT_FALSE(std::filesystem::exists(bad));
+}
+
+TEST(RenderCli, CheckerTexture) {
+  test::ScratchDir dir("render_cli_checker");
+  const std::string spot = test::quoted_data_path("spot.obj");
+  const std::string out = dir.file("spot.png").string(), plain = dir.file("plain.png").string();
+  const test::CommandResult r =
+      test::run_cli("render " + spot + " " + test::shell_quote(out) + " --texture checker --size 320x240");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.err, "");
+  ASSERT_EQ(test::run_cli("render " + spot + " " + test::shell_quote(plain) + " --size 320x240").exit_code, 0);
+  EXPECT_NE(read_png(out).pixels, read_png(plain).pixels);
+  const std::string coarse = dir.file("coarse.png").string();
+  ASSERT_EQ(test::run_cli("render " + spot + " " + test::shell_quote(coarse) +
+                          " --texture checker --checker-squares 4 --size 320x240")
+                .exit_code,
+            0);
+  EXPECT_NE(read_png(coarse).pixels, read_png(out).pixels);
+
+  // No texture coordinates, a square count out of range, an unknown texture: one line each.
+  const std::string bad = test::shell_quote(dir.file("bad.png").string());
+  for (const std::string& args :
+       {test::quoted_data_path("sphere_low.off") + " " + bad + " --texture checker",
+        spot + " " + bad + " --texture checker --checker-squares 0",
+        spot + " " + bad + " --texture checker --checker-squares 300", spot + " " + bad + " --texture marble"}) {
+    const test::CommandResult e = test::run_cli("render " + args);
+    EXPECT_NE(e.exit_code, 0) << args;
+    EXPECT_EQ(std::count(e.err.begin(), e.err.end(), '\n'), 1) << e.err;
+    EXPECT_TRUE(e.err.find("--texture") != std::string::npos || e.err.find("--checker-squares") != std::string::npos)
+        << e.err;
+  }
+  EXPECT_FALSE(std::filesystem::exists(dir.file("bad.png")));
 }
 
 TEST(RenderCli, BadArgumentsGiveOneLineErrors) {
