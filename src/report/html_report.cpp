@@ -27,6 +27,10 @@ namespace {
 
 using Json = nlohmann::ordered_json;
 
+// Checker squares per unit of texture coordinate in the page's texture view at first (the page
+// can change it); render.h's default.
+constexpr int kCheckerSquares = 16;
+
 // The page reads the arrays with Float32Array / Uint32Array views, which use the browser's byte
 // order: little-endian on every platform a browser runs on. Bytes are copied as they are.
 static_assert(std::endian::native == std::endian::little, "the report's typed arrays are little-endian");
@@ -228,6 +232,54 @@ std::vector<float> float_positions(const Vertices& P, const Eigen::Vector3d& off
   return out;
 }
 
+// A mesh's texture coordinates as the render's checker uses them (render.h): the first TexCoord
+// corner channel with two components, else the first such vertex channel; nullopt without.
+// Returned per face corner (#F x 6: u, v of corners 0, 1, 2); a corner without a value (-1)
+// gets the centre of the first (light) square at the default count, as the render does.
+std::optional<Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>> corner_texcoords(const Mesh& mesh) {
+  Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor> uv(mesh.F.rows(), 6);
+  for (const CornerChannel& c : mesh.attributes.corner) {
+    if (c.channel.role != AttributeRole::TexCoord || c.channel.width() < 2 || c.corners.rows() != mesh.F.rows())
+      continue;
+    for (Index f = 0; f < mesh.F.rows(); ++f)
+      for (int k = 0; k < 3; ++k) {
+        const std::int32_t row = c.corners(f, k);
+        const bool valid = row >= 0 && row < c.channel.rows();
+        uv(f, 2 * k) = valid ? c.channel.values(row, 0) : 0.5 / kCheckerSquares;
+        uv(f, 2 * k + 1) = valid ? c.channel.values(row, 1) : 0.5 / kCheckerSquares;
+      }
+    return uv;
+  }
+  for (const AttributeChannel& c : mesh.attributes.vertex) {
+    if (c.role != AttributeRole::TexCoord || c.width() < 2 || c.rows() != mesh.V.rows()) continue;
+    for (Index f = 0; f < mesh.F.rows(); ++f)
+      for (int k = 0; k < 3; ++k) {
+        uv(f, 2 * k) = c.values(mesh.F(f, k), 0);
+        uv(f, 2 * k + 1) = c.values(mesh.F(f, k), 1);
+      }
+    return uv;
+  }
+  return std::nullopt;
+}
+
+// Texture coordinates per corner of the display faces: a display face takes those of the first
+// mesh face mapped to it, whose corners lie in its clusters in the same order (clustered_faces
+// keeps the first face's corner order), so a decimated view still shows the pattern.
+std::vector<float> display_texcoords(const Eigen::Matrix<double, Eigen::Dynamic, 6, Eigen::RowMajor>& uv,
+                                     const DisplayFaces& faces) {
+  std::vector<float> out(6 * static_cast<std::size_t>(faces.size()));
+  std::vector<char> done(static_cast<std::size_t>(faces.size()), 0);
+  for (std::size_t f = 0; f < faces.face_of.size(); ++f) {
+    const Index d = faces.face_of[f];
+    if (d < 0 || done[static_cast<std::size_t>(d)]) continue;
+    done[static_cast<std::size_t>(d)] = 1;
+    for (int k = 0; k < 6; ++k)
+      out[6 * static_cast<std::size_t>(d) + static_cast<std::size_t>(k)] =
+          static_cast<float>(uv(static_cast<Index>(f), k));
+  }
+  return out;
+}
+
 // Colour stops and end labels of one map, for the page's legend.
 Json legend(const Eigen::VectorXd& stops, double limit, std::string low, std::string high, std::string unit) {
   const Colors c = diverging_colors(stops, limit);
@@ -376,6 +428,14 @@ std::string report_page(const Mesh& input, const Mesh& result, const Eigen::Vect
   }
   data["input"] = mesh_data(input.V, H_input, d.faces, q_input);
   data["result"] = mesh_data(result.V, H_result, result_faces, q_result);
+  // The checker view needs texture coordinates on both sides; absent otherwise, so a page
+  // without them is the same as before.
+  const auto input_uv = corner_texcoords(input), result_uv = corner_texcoords(result);
+  if (input_uv && result_uv) {
+    data["input"]["uv"] = base64(display_texcoords(*input_uv, d.faces));
+    data["result"]["uv"] = base64(display_texcoords(*result_uv, result_faces));
+    data["texture"] = {{"squares", kCheckerSquares}};
+  }
   data["displacement"] = base64(diverging_colors(average(d.vertex_of, d.num_vertices, moved), moved_limit));
   data["legend"] = {
       {"mean_curvature", legend(Eigen::Vector3d(-H_limit, 0, H_limit), H_limit, fmt::format("{:.3g}", -H_limit),

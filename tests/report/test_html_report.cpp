@@ -1,7 +1,8 @@
 // The HTML report page: self-contained, both meshes' data decoded back and compared with the
 // meshes, colours wired to the right quantities, deterministic bytes, display decimation of
-// large meshes, results with faces of their own (edge flips). The page in a real browser is
-// tested by web/tests/report_browser.mjs.
+// large meshes, results with faces of their own (edge flips), each mesh's own texture
+// coordinates for the checker view. The page in a real browser is tested by
+// web/tests/report_browser.mjs.
 #include "page_data.h"
 #include "shapes.h"
 #include "test_support.h"
@@ -480,6 +481,114 @@ TEST(HtmlReport, DecimatedResultMapsItsOwnFacesThroughTheSameClusters) {
   EXPECT_EQ(decode_base64(fd["result"]["quality"].get<std::string>()).size(),
             static_cast<std::size_t>(3 * result_faces));
   EXPECT_EQ(decode_base64(fd["displacement"].get<std::string>()).size(), static_cast<std::size_t>(3 * vertices));
+}
+
+// Texture coordinates (u, v) = f(position) per corner: a corner channel with one row per
+// corner (as a seam would give), or a vertex channel.
+Mesh with_texcoords(Mesh mesh, double shift, bool per_corner) {
+  const auto uv_of = [&](Index v) {
+    return Eigen::RowVector2d(0.5 + 0.3 * mesh.V(v, 0) + shift, 0.5 + 0.3 * mesh.V(v, 1) - 0.2 * mesh.V(v, 2));
+  };
+  AttributeChannel uv;
+  uv.name = "uv";
+  uv.components = {"u", "v"};
+  uv.role = AttributeRole::TexCoord;
+  if (!per_corner) {
+    uv.values.resize(mesh.V.rows(), 2);
+    for (Index v = 0; v < mesh.V.rows(); ++v) uv.values.row(v) = uv_of(v);
+    mesh.attributes.vertex.push_back(std::move(uv));
+    return mesh;
+  }
+  CornerChannel corners;
+  corners.corners.resize(mesh.F.rows(), 3);
+  uv.values.resize(3 * mesh.F.rows(), 2);
+  for (Index f = 0; f < mesh.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      uv.values.row(3 * f + k) = uv_of(mesh.F(f, k));
+      corners.corners(f, k) = 3 * f + k;
+    }
+  corners.channel = std::move(uv);
+  mesh.attributes.corner.push_back(std::move(corners));
+  return mesh;
+}
+
+// The page's (u, v) of every display corner against the mesh's, face by face.
+void expect_texcoords(const nlohmann::json& field, const Mesh& mesh, double shift, const char* what) {
+  const auto uv = decode_array<float>(field);
+  ASSERT_EQ(uv.size(), static_cast<std::size_t>(6 * mesh.num_faces())) << what;
+  for (Index f = 0; f < mesh.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const Index v = mesh.F(f, k);
+      const std::size_t i = 6 * static_cast<std::size_t>(f) + 2 * static_cast<std::size_t>(k);
+      ASSERT_NEAR(uv[i], 0.5 + 0.3 * mesh.V(v, 0) + shift, 1e-6) << what << " face " << f;
+      ASSERT_NEAR(uv[i + 1], 0.5 + 0.3 * mesh.V(v, 1) - 0.2 * mesh.V(v, 2), 1e-6) << what << " face " << f;
+    }
+}
+
+TEST(HtmlReport, CheckerViewGetsEachMeshsOwnTextureCoordinates) {
+  const Pair plain = torus_pair();
+  for (const bool per_corner : {true, false}) {
+    // The result's coordinates differ from the input's (as re-sampled ones do): the page must
+    // carry each mesh's own, not one set for both.
+    const Mesh input = with_texcoords(plain.input, 0, per_corner);
+    const Mesh result = with_texcoords(plain.result, 0.01, per_corner);
+    const std::string html = html_report(input, result, "");
+    const nlohmann::json data = page_data(html);
+    ASSERT_TRUE(data.contains("texture")) << per_corner;
+    EXPECT_EQ(data["texture"]["squares"], 16);
+    expect_texcoords(data["input"]["uv"], input, 0, "input");
+    expect_texcoords(data["result"]["uv"], result, 0.01, "result");
+    // The page offers the view: its controls in the page, the viewer script using them.
+    EXPECT_NE(html.find(R"(id="checker")"), std::string::npos);
+    EXPECT_NE(html.find(R"(id="checker-squares")"), std::string::npos);
+    EXPECT_NE(html.find("checker-controls"), std::string::npos);
+    EXPECT_GE(count(html, "checker-squares"), 2u) << "the viewer script does not read the control";
+  }
+  // Without coordinates on both sides, no texture data at all (the page as before).
+  for (const auto& [input, result] :
+       {std::pair{plain.input, plain.result}, std::pair{with_texcoords(plain.input, 0, true), plain.result},
+        std::pair{plain.input, with_texcoords(plain.result, 0, true)}}) {
+    const nlohmann::json data = page_data(html_report(input, result, ""));
+    EXPECT_FALSE(data.contains("texture"));
+    EXPECT_FALSE(data["input"].contains("uv"));
+    EXPECT_FALSE(data["result"].contains("uv"));
+  }
+  // A channel of another role is not texture coordinates.
+  Mesh labelled = plain.input;
+  labelled.set_vertex_property("u", Eigen::VectorXd::Zero(labelled.num_vertices()));
+  EXPECT_FALSE(page_data(html_report(labelled, labelled, "")).contains("texture"));
+}
+
+// Edge flips: the result's coordinates follow its own faces; decimated, every display face has
+// its corners' coordinates (those of a mesh face mapped to it).
+TEST(HtmlReport, CheckerCoordinatesFollowOwnAndDecimatedFaces) {
+  const Pair flipped = flipped_ellipsoid_pair(3);
+  const Mesh input = with_texcoords(flipped.input, 0, true);
+  const Mesh result = with_texcoords(flipped.result, 0.02, true);
+  const nlohmann::json data = page_data(html_report(input, result, ""));
+  expect_texcoords(data["input"]["uv"], input, 0, "input");
+  expect_texcoords(data["result"]["uv"], result, 0.02, "flipped result");
+
+  const Mesh sphere = with_texcoords(test::icosphere(1.0, 5), 0, true);
+  HtmlReportOptions options;
+  options.max_display_faces = 3000;
+  const nlohmann::json d = page_data(html_report(sphere, sphere, "", options));
+  ASSERT_EQ(d["display"]["decimated"], true);
+  const std::size_t faces = d["display"]["faces"];
+  const auto uv = decode_array<float>(d["input"]["uv"]);
+  ASSERT_EQ(uv.size(), 6 * faces);
+  // Each display corner's coordinates are those of a vertex in its cluster: within a cluster's
+  // size (the display's mean positions) of f(display position).
+  const auto positions = decode_array<float>(d["input"]["positions"]);
+  const auto indices = decode_array<std::uint32_t>(d["display"]["indices"]);
+  double worst = 0;
+  for (std::size_t i = 0; i < indices.size(); ++i) {
+    const float* p = &positions[3 * indices[i]];
+    worst = std::max(worst, std::abs(uv[2 * i] - (0.5 + 0.3 * p[0])));
+    worst = std::max(worst, std::abs(uv[2 * i + 1] - (0.5 + 0.3 * p[1] - 0.2 * p[2])));
+  }
+  EXPECT_LT(worst, 0.05);
+  EXPECT_EQ(d["result"]["uv"], d["input"]["uv"]);
 }
 
 TEST(HtmlReport, WritesTheFileAtomically) {

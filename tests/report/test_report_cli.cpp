@@ -12,6 +12,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <filesystem>
 #include <set>
@@ -52,6 +53,29 @@ TEST(CliReport, EnhanceWritesTheHtmlReportWithTheJsonMetrics) {
   EXPECT_EQ(data["labels"]["input"], "fandisk.off");
   EXPECT_EQ(data["labels"]["result"], "out.ply");
   EXPECT_NE(r.err.find("HTML report written to"), std::string::npos) << r.err;
+}
+
+// spot.obj's texture coordinates reach the page on both sides, the result's re-sampled by
+// enhance, for the checker view.
+TEST(CliReport, EnhanceReportOfATexturedMeshHasTheCheckerView) {
+  test::ScratchDir dir("cli-report-spot");
+  const auto out = dir.file("out.obj"), html = dir.file("r.html");
+  const auto r = run_cli("--quiet enhance " + q(test::data_path("spot.obj")) + " " + q(out) + " --html " + q(html));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto data = test::page_data(test::read_text(html));
+  ASSERT_TRUE(data.contains("texture"));
+  const std::size_t faces = data["display"]["faces"];
+  const auto input_uv = test::decode_array<float>(data["input"]["uv"]);
+  const auto result_uv = test::decode_array<float>(data["result"]["uv"]);
+  ASSERT_EQ(input_uv.size(), 6 * faces);
+  ASSERT_EQ(result_uv.size(), 6 * faces);
+  EXPECT_NE(input_uv, result_uv) << "the result's coordinates are the input's: not re-sampled?";
+  // Re-sampled, not scrambled: every corner stays near its input value (0.043 measured, in
+  // a [0, 1] chart).
+  double worst = 0;
+  for (std::size_t i = 0; i < input_uv.size(); ++i)
+    worst = std::max(worst, double(std::abs(input_uv[i] - result_uv[i])));
+  EXPECT_LT(worst, 0.1);
 }
 
 std::set<std::string> keys(const nlohmann::json& j) {

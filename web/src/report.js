@@ -6,19 +6,26 @@
 // shared by both meshes: the flow keeps connectivity), display.result_indices the result's own
 // faces when it has them (edge flips: same vertices, other faces; absent otherwise),
 // <mesh>.positions float32 (3 per vertex, relative to `offset`), <mesh>.mean_curvature and
-// displacement RGB bytes per vertex, <mesh>.quality RGB bytes per face of that mesh's faces.
+// displacement RGB bytes per vertex, <mesh>.quality RGB bytes per face of that mesh's faces,
+// and, when both meshes have texture coordinates, <mesh>.uv float32 (u, v per corner of that
+// mesh's display faces, face by face) with texture.squares, the checker's squares per unit.
 import {
   BufferAttribute,
   BufferGeometry,
   Color,
+  DataTexture,
   DirectionalLight,
   DoubleSide,
   HemisphereLight,
+  LinearFilter,
+  LinearMipmapLinearFilter,
   LinearSRGBColorSpace,
   Mesh,
   MeshBasicMaterial,
   MeshPhongMaterial,
   PerspectiveCamera,
+  RepeatWrapping,
+  RGBAFormat,
   Scene,
   Sphere,
   WebGLRenderer,
@@ -63,6 +70,51 @@ function faceColoredGeometry(positions, indices, faceColors) {
   return geometry;
 }
 
+// Per-vertex values (3 per vertex) copied to every corner of every face: what a non-indexed
+// geometry needs.
+function perCorner(values, indices, ArrayType) {
+  const out = new ArrayType(indices.length * 3);
+  for (let i = 0; i < indices.length; ++i) {
+    const v = indices[i];
+    out[3 * i] = values[3 * v];
+    out[3 * i + 1] = values[3 * v + 1];
+    out[3 * i + 2] = values[3 * v + 2];
+  }
+  return out;
+}
+
+// Per-face values (3 per face) copied to its three corners.
+function faceToCorners(values, faces) {
+  const out = new Uint8Array(faces * 9);
+  for (let f = 0; f < faces; ++f)
+    for (let k = 0; k < 3; ++k) out.set(values.subarray(3 * f, 3 * f + 3), 9 * f + 3 * k);
+  return out;
+}
+
+// The checkerboard: one period of 2 x 2 squares, dark and light grey (0.35 and 0.9, as
+// `vertexflow render --texture checker`), repeated squares / 2 times per unit of texture
+// coordinate; mipmapped so receding squares fade to grey instead of flickering.
+const CHECKER_TEXELS = 128;
+function checkerTexture(squares, anisotropy) {
+  const n = CHECKER_TEXELS;
+  const texels = new Uint8Array(n * n * 4);
+  for (let y = 0; y < n; ++y) {
+    for (let x = 0; x < n; ++x) {
+      const grey = (Math.floor((2 * x) / n) + Math.floor((2 * y) / n)) % 2 ? 89 : 230;
+      texels.set([grey, grey, grey, 255], 4 * (y * n + x));
+    }
+  }
+  const texture = new DataTexture(texels, n, n, RGBAFormat);
+  texture.wrapS = texture.wrapT = RepeatWrapping;
+  texture.magFilter = LinearFilter;
+  texture.minFilter = LinearMipmapLinearFilter;
+  texture.generateMipmaps = true;
+  texture.anisotropy = anisotropy;
+  texture.repeat.set(squares / 2, squares / 2);
+  texture.needsUpdate = true;
+  return texture;
+}
+
 class View {
   constructor(canvas, meshData, indices, displacement, camera) {
     this.canvas = canvas;
@@ -85,6 +137,13 @@ class View {
     };
     this.faceColors = bytesFromBase64(meshData.quality);
     this.faceGeometry = null;
+    // Texture coordinates belong to face corners (a seam gives a vertex several): the checker
+    // view draws a non-indexed copy, built the first time it is shown.
+    this.uv = meshData.uv !== undefined ? float32FromBase64(meshData.uv) : null;
+    this.cornerGeometry = null;
+    this.cornerColors = {};
+    this.texture = null;
+    this.colormap = 'none';
 
     this.geometry = new BufferGeometry();
     this.geometry.setAttribute('position', new BufferAttribute(this.positions, 3));
@@ -111,8 +170,45 @@ class View {
   }
 
   setColormap(name) {
+    this.colormap = name;
+    this.update();
+  }
+
+  // squares: checker squares per unit of texture coordinate, or 0 for no texture.
+  setChecker(squares) {
+    if (!squares || !this.uv) {
+      this.material.map = null;
+    } else {
+      this.texture ??= checkerTexture(squares, this.renderer.capabilities.getMaxAnisotropy());
+      this.texture.repeat.set(squares / 2, squares / 2);
+      this.material.map = this.texture;
+    }
+    this.update();
+  }
+
+  // The geometry and material for the colour map and texture: the shared indexed geometry, the
+  // quality map's per-face copy, or, with the checker, the per-corner copy with smooth normals
+  // and the map's colours per corner.
+  update() {
+    const name = this.colormap;
+    const textured = this.material.map !== null;
     let geometry = this.geometry;
-    if (name === 'quality') {
+    if (textured) {
+      if (!this.cornerGeometry) {
+        this.cornerGeometry = new BufferGeometry();
+        this.cornerGeometry.setAttribute('position', new BufferAttribute(perCorner(this.positions, this.indices, Float32Array), 3));
+        this.cornerGeometry.setAttribute('normal',
+          new BufferAttribute(perCorner(this.geometry.getAttribute('normal').array, this.indices, Float32Array), 3));
+        this.cornerGeometry.setAttribute('uv', new BufferAttribute(this.uv, 2));
+      }
+      geometry = this.cornerGeometry;
+      if (name !== 'none') {
+        this.cornerColors[name] ??= name === 'quality'
+          ? faceToCorners(this.faceColors, this.indices.length / 3)
+          : perCorner(this.vertexColors[name], this.indices, Uint8Array);
+        geometry.setAttribute('color', new BufferAttribute(this.cornerColors[name], 3, true));
+      }
+    } else if (name === 'quality') {
       this.faceGeometry ??= faceColoredGeometry(this.positions, this.indices, this.faceColors);
       geometry = this.faceGeometry;
     } else if (name !== 'none') {
@@ -122,7 +218,8 @@ class View {
     this.wire.geometry = geometry;
     const colored = name !== 'none';
     this.material.vertexColors = colored;
-    this.material.color.set(colored ? 0xffffff : PLAIN);
+    // The texture multiplies the surface colour: a lighter grey keeps the dark squares readable.
+    this.material.color.set(colored ? 0xffffff : textured ? 0xe0e0e0 : PLAIN);
     this.material.needsUpdate = true;
   }
 
@@ -357,6 +454,22 @@ function main() {
 
   const wireframe = document.getElementById('wireframe');
   const colormap = document.getElementById('colormap');
+  // The checker texture: offered only when both meshes have texture coordinates.
+  const checker = document.getElementById('checker');
+  const checkerSquares = document.getElementById('checker-squares');
+  if (data.texture) {
+    document.getElementById('checker-controls').hidden = false;
+    checkerSquares.value = String(data.texture.squares);
+    const applyChecker = () => {
+      const squares = Math.min(256, Math.max(1, Math.round(Number(checkerSquares.value) || data.texture.squares)));
+      for (const view of views) view.setChecker(checker.checked ? squares : 0);
+      document.body.dataset.checker = checker.checked ? String(squares) : '0';
+      renderAll();
+    };
+    checker.addEventListener('change', applyChecker);
+    checkerSquares.addEventListener('change', applyChecker);
+    if (checker.checked) applyChecker();
+  }
   wireframe.addEventListener('change', () => {
     for (const view of views) view.setWireframe(wireframe.checked);
     renderAll();
