@@ -16,6 +16,7 @@ packages=(
   libcli11-dev             # command-line parsing
   libfmt-dev               # formatting
   nlohmann-json3-dev       # JSON output
+  libtinygltf-dev          # glTF 2.0 reading and writing (tiny_gltf.h; uses nlohmann-json3-dev)
   zlib1g-dev               # gzip-compressed meshes
   libosmesa6-dev           # off-screen software OpenGL (llvmpipe) for `vertexflow render`
   libpng-dev               # PNG output of renders
@@ -49,8 +50,9 @@ if [ ${#missing[@]} -ne 0 ]; then
   $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 
-# npm packages of web/ (three.js, esbuild, playwright-core) exactly as package-lock.json pins
-# them; skipped when node_modules was installed from this very lock file.
+# npm packages of web/ (three.js, esbuild, playwright-core, gltf-validator for
+# scripts/validate_gltf.mjs) exactly as package-lock.json pins them; skipped when node_modules
+# was installed from this very lock file.
 web="$(cd "$(dirname "$0")/.." && pwd)/web"
 stamp="$web/node_modules/.vertexflow-package-lock.json"
 if ! cmp -s "$web/package-lock.json" "$stamp"; then

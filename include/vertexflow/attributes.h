@@ -73,6 +73,10 @@ struct CornerChannel {
   Eigen::Matrix<std::int32_t, Eigen::Dynamic, 3, Eigen::RowMajor> corners;
 };
 
+/// The glTF document a mesh was read from (opaque here; src/io/gltf.h): its materials, textures,
+/// images, nodes, skins and animations, written back around the mesh's new accessors.
+struct GltfDocument;
+
 /// Everything a mesh carries besides V and F.
 struct MeshAttributes {
   /// One row per vertex; in a PLY, the vertex properties after x, y, z, in file order.
@@ -85,6 +89,9 @@ struct MeshAttributes {
   std::vector<std::string> materials, groups, objects;
   /// OBJ `mtllib` file names, in file order.
   std::vector<std::string> material_libraries;
+  /// Set by the glTF reader: the document, which the glTF writer fills with the mesh's values
+  /// (io.h). Shared, never modified: copies of a mesh share it.
+  std::shared_ptr<const GltfDocument> gltf;
 
   [[nodiscard]] bool empty() const {
     return vertex.empty() && corner.empty() && face.empty() && material_libraries.empty();

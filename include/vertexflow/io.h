@@ -1,35 +1,23 @@
 // Mesh input and output: OBJ, PLY (ASCII, binary little/big endian), OFF (ASCII, binary), STL
-// (ASCII, binary), each optionally gzip-compressed on input and output (`NAME.EXT.gz`).
+// (ASCII, binary), each optionally gzip-compressed on input and output (`NAME.EXT.gz`), and
+// glTF 2.0 (`.gltf` with its external buffers and images, `.glb`; not gzip-compressed).
 //
-// Reading produces a clean triangle mesh:
-// - polygons are triangulated (quads by the valid, better-shaped diagonal; larger simple
-//   polygons in their best-fit plane in O(n log n), by a monotone partition and Delaunay edge
-//   flips, so non-convex ones are right; the flips stop after 8n, so a long spiral may end
-//   short of Delaunay, still a valid triangulation; self-intersecting ones are fanned);
-// - STL's per-facet vertices are welded (bitwise-equal positions become one vertex);
-// - unreferenced vertices, faces with a repeated index, duplicate faces (same vertex set, any
-//   order or orientation) and zero-area faces (area < kDegenerateAreaRelative * diagonal^2) are
-//   removed, each counted in ReadReport;
-// - otherwise vertex order is kept, so per-vertex data in the file stays aligned.
-// Comment lines become Mesh::comments (their text after the marker, blanks trimmed): PLY
-// `comment` header lines, OBJ lines starting with '#', and OFF '#' comments before the element
-// counts and between records (a '#' after a record's values on its line is skipped unread).
-// Only the first kMaxCommentLines are kept, each cut to kMaxCommentBytes and with control
-// characters replaced by '?', so a file of a million comment lines costs no more memory than
-// 256; empty comments and the writers' own stamp ("written by vertexflow") are dropped. STL
-// has no comments: its `solid NAME` names the solid, and the 80-byte binary header is free bytes
-// that many writers fill with binary data; neither is read.
-// Common real-world forms are read: OBJ lines continued with a trailing backslash, OFF counts
-// on the keyword's line, ASCII PLY lines with more values than declared (the extra ones are
-// ignored and counted in ReadReport).
-// A mesh whose bounding-box diagonal lies outside [1e-60, 1e60] is refused: squared areas
-// would overflow or underflow in double precision.
-//
-// Every failure throws IoError with a one-line message that starts with the file name.
-// Allocation is bounded by the file's size: a header that claims more elements than the file
-// can hold is an error, not an allocation. gzip input is parsed as it is inflated: the header
-// is checked after the first bytes, memory follows what is read, and the inflated size is
-// capped (ReadOptions::max_inflate_ratio).
+// glTF: the triangle primitives of every mesh of the document (indexed or not; strips and fans
+// are named as not kept), in the meshes' own coordinates (node transforms are not applied),
+// their vertices welded where their positions are bitwise equal within a glTF mesh (glTF
+// splits a vertex wherever an attribute differs) so that the mesh is connected for the flow.
+// Each primitive's vertex attributes (NORMAL, TEXCOORD_n, COLOR_0, JOINTS_0, WEIGHTS_0, TANGENT)
+// become corner channels whose rows are the glTF vertices, so writing splits them again exactly
+// where the file did; face channels "primitive" and "material" say where each face came from.
+// The face list is always kept as the file has it (ReadOptions::keep_face_list is implied).
+// Writing a mesh read from glTF writes the input document (MeshAttributes::gltf) with only
+// those accessors' values (and the indices, where edge flips changed faces) replaced, and only
+// where they changed: materials, textures, images, nodes, skins and animations pass through
+// (morph targets are not moved with the vertices). A .glb holds every buffer and image in its
+// binary chunk; a .gltf's external files are written beside it as STEM.bin and STEM_IMAGE, so
+// that they never overwrite the input's. Any other mesh is written as a new document with one
+// primitive per material.
+
 #pragma once
 
 #include "vertexflow/mesh.h"
@@ -50,14 +38,14 @@ class IoError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-enum class MeshFormat { Obj, Ply, Off, Stl };
+enum class MeshFormat { Obj, Ply, Off, Stl, Gltf };
 
 /// Most comment lines a reader keeps (the first ones; the rest are skipped).
 inline constexpr std::size_t kMaxCommentLines = 256;
 /// Most bytes of one comment line a reader keeps (the rest of the line is skipped).
 inline constexpr std::size_t kMaxCommentBytes = 1024;
 
-/// "OBJ", "PLY", "OFF" or "STL".
+/// "OBJ", "PLY", "OFF", "STL" or "glTF".
 const char* format_name(MeshFormat format);
 
 /// The extension of `path` with its dot, lowercase (".ply"); empty when it has none.

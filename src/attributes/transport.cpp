@@ -68,7 +68,11 @@ class Walker {
  public:
   Walker(const Mesh& input, const std::vector<Index>& faces, const Topology& topology, const std::vector<char>& flag,
          double slack)
-      : input_(input), faces_(faces), topology_(topology), flag_(flag), slack_(slack),
+      : input_(input),
+        faces_(faces),
+        topology_(topology),
+        flag_(flag),
+        slack_(slack),
         seen_(static_cast<std::size_t>(topology.num_faces), 0) {}
 
   Location locate(const Eigen::Vector3d& p, const std::vector<Index>& seeds) {
@@ -159,8 +163,11 @@ Eigen::RowVectorXd blend(const AttributeChannel& c, const std::array<Eigen::Inde
   Eigen::RowVectorXd value = Eigen::RowVectorXd::Zero(c.width());
   for (int k = 0; k < 3; ++k) value += b[k] * c.values.row(rows[static_cast<std::size_t>(k)]);
   if (c.role == AttributeRole::Weights) {
+    // Sum 1, or for normalised integers (glTF's unsigned byte and short weights) the type's
+    // largest value, which stands for 1.
+    const double one = is_integer_type(c.type) ? to_scalar_type(1e300, c.type) : 1.0;
     const double sum = value.sum();
-    if (sum > 0) value /= sum;
+    if (sum > 0) value *= one / sum;
   }
   if (is_integer_type(c.type))
     for (int k = 0; k < c.width(); ++k) value[k] = to_scalar_type(value[k], c.type);
@@ -170,7 +177,8 @@ Eigen::RowVectorXd blend(const AttributeChannel& c, const std::array<Eigen::Inde
 // Area-weighted unit normals of faces `F` at V: per vertex (`per_vertex`), or per row of a
 // corner table. Rows whose faces did not change keep `old` exactly, and the orientation of
 // `old` is kept (inward normals stay inward).
-void recompute_normals(AttributeChannel& channel, const Eigen::Matrix<std::int32_t, Eigen::Dynamic, 3, Eigen::RowMajor>* corners,
+void recompute_normals(AttributeChannel& channel,
+                       const Eigen::Matrix<std::int32_t, Eigen::Dynamic, 3, Eigen::RowMajor>* corners,
                        const Vertices& V, const Faces& F, const std::vector<char>& face_changed) {
   const Eigen::Index rows = channel.rows();
   Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(rows, 3);
@@ -224,7 +232,9 @@ MeshAttributes transport_attributes(const Mesh& input, const std::vector<Index>&
   std::vector<std::vector<std::vector<Index>>> wedges(movers.size());
   std::vector<std::vector<Location>> located(movers.size());
   if (any_interpolated) {
-    const double slack = 2 * mean_edge_length(input.V, topology);
+    // Within a quarter edge of the best face so far: the flow's vertices are on the surface
+    // (best about 0), so this is the ring around the landing point, not a disk of faces.
+    const double slack = 0.25 * mean_edge_length(input.V, topology);
     tbb::enumerable_thread_specific<Walker> walkers([&] { return Walker(input, faces, topology, flag, slack); });
     tbb::parallel_for(std::size_t{0}, movers.size(), [&](std::size_t i) {
       Walker& walker = walkers.local();
@@ -251,7 +261,8 @@ MeshAttributes transport_attributes(const Mesh& input, const std::vector<Index>&
       if (located[i].empty() || located[i].front().face < 0) continue;
       const Location& l = located[i].front();
       const Index face = faces[static_cast<std::size_t>(l.face)];
-      out.vertex[c].values.row(movers[i]) = blend(in, {input.F(face, 0), input.F(face, 1), input.F(face, 2)}, l.barycentric);
+      out.vertex[c].values.row(movers[i]) =
+          blend(in, {input.F(face, 0), input.F(face, 1), input.F(face, 2)}, l.barycentric);
     }
   }
   // Corner channels: each wedge in its own chart. A row used by this vertex's wedge alone is

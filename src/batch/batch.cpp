@@ -84,7 +84,8 @@ void run_file(const std::filesystem::path& input, const std::filesystem::path& o
   if (!lost.empty()) {
     std::string list;
     for (const std::string& l : lost) list += (list.empty() ? "" : ", ") + l;
-    warnings.push_back(std::string(format_name(format_from_path(output))) + " cannot hold, so the output does not get: " + list);
+    warnings.push_back(std::string(format_name(format_from_path(output))) +
+                       " cannot hold, so the output does not get: " + list);
     row.warnings = join(warnings);
   }
   write_mesh(output, result.mesh);

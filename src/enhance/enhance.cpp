@@ -521,7 +521,8 @@ EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const
       if (!in_workable[static_cast<std::size_t>(f)])
         for (int k = 0; k < 3; ++k) held[static_cast<std::size_t>(mesh.F(f, k))] = 1;
   }
-  const bool whole = faces.size() == static_cast<std::size_t>(mesh.num_faces()) && to_input.size() == static_cast<std::size_t>(n);
+  const bool whole =
+      faces.size() == static_cast<std::size_t>(mesh.num_faces()) && to_input.size() == static_cast<std::size_t>(n);
   if (whole && mesh.attributes.empty()) return enhance_clean(mesh, reference, options, callbacks);
 
   // Chart boundaries (seams, material boundaries) are creases for the flow and never flipped.
@@ -550,14 +551,16 @@ EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const
   for (const auto& [a, b] : options.constraints.crease_edges)
     if (a >= 0 && b >= 0 && a < n && b < n && to_work[static_cast<std::size_t>(a)] >= 0 &&
         to_work[static_cast<std::size_t>(b)] >= 0)
-      o.constraints.crease_edges.push_back({to_work[static_cast<std::size_t>(a)], to_work[static_cast<std::size_t>(b)]});
+      o.constraints.crease_edges.push_back(
+          {to_work[static_cast<std::size_t>(a)], to_work[static_cast<std::size_t>(b)]});
   for (const auto& [a, b] : seams)
     o.constraints.crease_edges.push_back({to_work[static_cast<std::size_t>(a)], to_work[static_cast<std::size_t>(b)]});
 
   EnhanceResult result = enhance_clean(work, reference, o, callbacks);
   Mesh out;
   out.V = mesh.V;
-  for (std::size_t w = 0; w < to_input.size(); ++w) out.V.row(to_input[w]) = result.mesh.V.row(static_cast<Eigen::Index>(w));
+  for (std::size_t w = 0; w < to_input.size(); ++w)
+    out.V.row(to_input[w]) = result.mesh.V.row(static_cast<Eigen::Index>(w));
   out.F = mesh.F;
   for (std::size_t i = 0; i < faces.size(); ++i)
     for (int k = 0; k < 3; ++k)
@@ -579,13 +582,11 @@ EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const
     const auto start = Clock::now();
     attributes_detail::TransportReport t;
     out.attributes = attributes_detail::transport_attributes(mesh, faces, topology, out.V, out.F, t);
-    result.report["attributes"] = {{"chart_boundary_edges", seams.size()},
-                                   {"vertices_moved", t.vertices_moved},
-                                   {"wedges_located", t.wedges_located},
-                                   {"max_location_distance_edges", t.max_location_distance},
-                                   {"rows_added", t.rows_added},
-                                   {"normal_channels_recomputed", t.normal_channels},
-                                   {"seconds", seconds_since(start)}};
+    result.report["attributes"] = {
+        {"chart_boundary_edges", seams.size()}, {"vertices_moved", t.vertices_moved},
+        {"wedges_located", t.wedges_located},   {"max_location_distance_edges", t.max_location_distance},
+        {"rows_added", t.rows_added},           {"normal_channels_recomputed", t.normal_channels},
+        {"seconds", seconds_since(start)}};
   }
   result.mesh = std::move(out);
   return result;

@@ -1,7 +1,7 @@
 // enhance_metrics (enhance.h): the figures of docs/metrics.md for an enhance result, as the
 // reports of `enhance --report`, `batch` and the Python module write them.
-#include "vertexflow/compare.h"
 #include "enhance/workable_faces.h"
+#include "vertexflow/compare.h"
 #include "vertexflow/curvature.h"
 #include "vertexflow/edge_flips.h"
 #include "vertexflow/enhance.h"

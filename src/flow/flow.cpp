@@ -78,9 +78,10 @@ FlowResult flow_on_manifold_split(const Vertices& V, const Faces& F, const Topol
   on_split.constraints.crease_edges.clear();
   for (const auto& [a, b] : options.constraints.crease_edges) {
     if (a < 0 || b < 0 || a >= static_cast<Index>(V.rows()) || b >= static_cast<Index>(V.rows())) continue;
-    for (Index s = split.first_copy[static_cast<std::size_t>(a)]; s < split.first_copy[static_cast<std::size_t>(a) + 1]; ++s)
-      for (Index t = split.first_copy[static_cast<std::size_t>(b)]; t < split.first_copy[static_cast<std::size_t>(b) + 1];
-           ++t)
+    for (Index s = split.first_copy[static_cast<std::size_t>(a)]; s < split.first_copy[static_cast<std::size_t>(a) + 1];
+         ++s)
+      for (Index t = split.first_copy[static_cast<std::size_t>(b)];
+           t < split.first_copy[static_cast<std::size_t>(b) + 1]; ++t)
         on_split.constraints.crease_edges.push_back({s, t});
   }
   for (Index v = 0; v < static_cast<Index>(V.rows()); ++v)

@@ -17,16 +17,16 @@ namespace vertexflow::io_detail {
 
 /// What a parser produces: vertices and polygons exactly as the file lists them.
 struct PolygonSoup {
-  std::vector<double> xyz;                 // 3 per vertex
-  std::vector<Index> corners;              // polygon corners, concatenated
-  std::vector<std::int64_t> offsets{0};    // polygon p is corners[offsets[p], offsets[p+1])
-  std::vector<std::uint8_t> rgb;           // empty or 3 per vertex (OFF colours)
+  std::vector<double> xyz;               // 3 per vertex
+  std::vector<Index> corners;            // polygon corners, concatenated
+  std::vector<std::int64_t> offsets{0};  // polygon p is corners[offsets[p], offsets[p+1])
+  std::vector<std::uint8_t> rgb;         // empty or 3 per vertex (OFF colours)
   // Channels as the file has them: vertex channels one row per vertex, face channels one row
   // per polygon, corner channels their own table, indexed by corner_rows.
   MeshAttributes attributes;
   // Per corner channel, the row each corner uses (-1 none), parallel to `corners`.
   std::vector<std::vector<std::int32_t>> corner_rows;
-  std::vector<std::string> comments;       // Mesh::comments, bounded by add_comment
+  std::vector<std::string> comments;  // Mesh::comments, bounded by add_comment
   // What the file holds that the mesh does not keep, with counts (ReadReport::not_kept).
   std::vector<std::pair<std::string, std::int64_t>> not_kept;
   bool weld_vertices = false;  // STL: facets carry their own vertex copies

@@ -1,5 +1,6 @@
 // Reading: load the bytes (decompressing gzip), dispatch to a format parser, then turn the
 // polygon soup into a clean triangle mesh.
+#include "gltf.h"
 #include "io_internal.h"
 
 #include <zlib.h>
@@ -231,9 +232,9 @@ Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& repor
   const bool track = !soup.attributes.corner.empty() || !soup.attributes.face.empty();
   std::vector<Index> tris;
   std::vector<Index> polygon;
-  std::vector<std::int64_t> polygon_corner;  // soup corner of each entry of `polygon`
+  std::vector<std::int64_t> polygon_corner;           // soup corner of each entry of `polygon`
   std::vector<std::int64_t> tri_corner, tri_polygon;  // per triangle corner, per triangle
-  EdgeSet edges;  // filled only when the file has polygons
+  EdgeSet edges;                                      // filled only when the file has polygons
   const bool has_polygons = soup.corners.size() != 3 * static_cast<std::size_t>(soup.num_polygons());
   const bool tracked = track && has_polygons;
   auto source_of = [&](std::size_t t) { return tracked ? tri_polygon[t] : static_cast<std::int64_t>(t); };
@@ -371,7 +372,7 @@ Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& repor
   attributes = std::move(soup.attributes);
   for (AttributeChannel& channel : attributes.face) {
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> rows(static_cast<Eigen::Index>(kept),
-                                                                                 channel.width());
+                                                                                channel.width());
     for (std::size_t f = 0; f < kept; ++f) {
       const std::int64_t p = source_of(static_cast<std::size_t>(kept_source[f]));
       if (p < channel.rows())
@@ -395,8 +396,9 @@ Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& repor
     color.components = {"red", "green", "blue"};
     color.type = ScalarType::UInt8;
     color.role = AttributeRole::Color;
-    color.values = Eigen::Map<const Eigen::Matrix<std::uint8_t, Eigen::Dynamic, 3, Eigen::RowMajor>>(soup.rgb.data(), nv, 3)
-                       .cast<double>();
+    color.values =
+        Eigen::Map<const Eigen::Matrix<std::uint8_t, Eigen::Dynamic, 3, Eigen::RowMajor>>(soup.rgb.data(), nv, 3)
+            .cast<double>();
   }
   mesh.comments = std::move(soup.comments);
   for (const auto& [what, count] : soup.not_kept) report.not_kept.push_back(fmt::format("{} ({})", what, count));
@@ -440,8 +442,12 @@ bool is_gzip_path(const std::filesystem::path& path) {
 }
 
 bool is_mesh_path(const std::filesystem::path& path) {
-  const std::string ext = lowercase_extension(is_gzip_path(path) ? path.stem() : path);
-  return ext == ".obj" || ext == ".ply" || ext == ".off" || ext == ".stl";
+  if (is_gzip_path(path)) {
+    const std::string ext = lowercase_extension(path.stem());
+    return ext == ".obj" || ext == ".ply" || ext == ".off" || ext == ".stl";
+  }
+  const std::string ext = lowercase_extension(path);
+  return ext == ".obj" || ext == ".ply" || ext == ".off" || ext == ".stl" || ext == ".gltf" || ext == ".glb";
 }
 
 MeshFormat format_from_path(const std::filesystem::path& path) {
@@ -450,9 +456,14 @@ MeshFormat format_from_path(const std::filesystem::path& path) {
   if (ext == ".ply") return MeshFormat::Ply;
   if (ext == ".off") return MeshFormat::Off;
   if (ext == ".stl") return MeshFormat::Stl;
-  io_detail::fail(path.string(),
-                  ext.empty() ? "no file extension; expected .obj, .ply, .off or .stl (optionally .gz)"
-                              : "unknown extension '" + ext + "'; expected .obj, .ply, .off or .stl (optionally .gz)");
+  if (ext == ".gltf" || ext == ".glb") {
+    if (is_gzip_path(path)) io_detail::fail(path.string(), "gzip-compressed glTF is not supported (.glb is compact)");
+    return MeshFormat::Gltf;
+  }
+  io_detail::fail(
+      path.string(),
+      ext.empty() ? "no file extension; expected .obj, .ply, .off, .stl (optionally .gz), .gltf or .glb"
+                  : "unknown extension '" + ext + "'; expected .obj, .ply, .off, .stl (optionally .gz), .gltf or .glb");
 }
 
 const char* format_name(MeshFormat format) {
@@ -465,6 +476,8 @@ const char* format_name(MeshFormat format) {
       return "OFF";
     case MeshFormat::Stl:
       return "STL";
+    case MeshFormat::Gltf:
+      return "glTF";
   }
   return "?";
 }
@@ -555,6 +568,8 @@ Mesh read_mesh_checked(std::string_view bytes, MeshFormat format, const std::str
       case MeshFormat::Stl:
         soup = io_detail::parse_stl(source, name, r);
         break;
+      case MeshFormat::Gltf:
+        break;  // read_mesh_from_memory hands glTF over before this
     }
     source.verify_rest();
   }  // the text is freed before the mesh is built
@@ -579,6 +594,12 @@ Mesh read_mesh_from_memory(std::string_view bytes, MeshFormat format, const std:
                            const ReadOptions& options) {
   ReadReport local;
   try {
+    if (format == MeshFormat::Gltf) {
+      ReadReport& r = report ? *report : local;
+      r = ReadReport{};
+      r.format = MeshFormat::Gltf;
+      return io_detail::read_gltf_bytes(bytes, name, r, options);
+    }
     return read_mesh_checked(bytes, format, name, report ? *report : local, options);
   } catch (const std::bad_alloc&) {
     io_detail::fail(name, "out of memory while reading the mesh");
@@ -589,6 +610,17 @@ Mesh read_mesh_from_memory(std::string_view bytes, MeshFormat format, const std:
 
 Mesh read_mesh(const std::filesystem::path& path, ReadReport* report, const ReadOptions& options) {
   const MeshFormat format = format_from_path(path);
+  if (format == MeshFormat::Gltf) {  // external buffers and images are found beside the file
+    ReadReport local;
+    ReadReport& r = report ? *report : local;
+    r = ReadReport{};
+    r.format = MeshFormat::Gltf;
+    try {
+      return io_detail::read_gltf_file(path, r, options);
+    } catch (const std::bad_alloc&) {
+      io_detail::fail(path.string(), "out of memory while reading the mesh");
+    }
+  }
   io_detail::FileBytes bytes;
   try {
     bytes = io_detail::read_file_bytes(path);

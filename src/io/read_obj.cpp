@@ -100,9 +100,11 @@ class ObjStatements {
 // The statements a mesh does not keep, by keyword (ReadReport::not_kept).
 void count_skipped_statement(std::string_view head, PolygonSoup& soup) {
   const std::string_view keyword = head.substr(0, head.find_first_of(" \t\r\n\\"));
-  static constexpr std::pair<std::string_view, std::string_view> kinds[] = {
-      {"vp", "OBJ parameter vertices vp"}, {"l", "OBJ lines l"},       {"p", "OBJ points p"},
-      {"curv", "OBJ curves curv"},         {"surf", "OBJ surfaces surf"}};
+  static constexpr std::pair<std::string_view, std::string_view> kinds[] = {{"vp", "OBJ parameter vertices vp"},
+                                                                            {"l", "OBJ lines l"},
+                                                                            {"p", "OBJ points p"},
+                                                                            {"curv", "OBJ curves curv"},
+                                                                            {"surf", "OBJ surfaces surf"}};
   for (const auto& [word, what] : kinds)
     if (keyword == word) return soup.count_not_kept(what);
 }
@@ -226,12 +228,14 @@ void attribute_statement(TextScanner& in, ObjStatements& statement, PolygonSoup&
 void finish_attributes(ObjAttributes& obj, PolygonSoup& soup, const std::string& name) {
   MeshAttributes& out = soup.attributes;
   auto corner_channel = [&](const char* channel_name, std::vector<std::string> components, AttributeRole role,
-                            const std::vector<double>& values, int stride, int width,
-                            std::vector<std::int32_t>& rows, const char* what) {
+                            const std::vector<double>& values, int stride, int width, std::vector<std::int32_t>& rows,
+                            const char* what) {
     const auto count = static_cast<Eigen::Index>(values.size() / static_cast<std::size_t>(stride));
     if (count == 0) {  // indices into a table the file does not have (some exporters): ignored
-      soup.count_not_kept(fmt::format("OBJ {} indices without any {} statement", what, std::string_view(what) == "normal" ? "vn" : "vt"),
-                          static_cast<std::int64_t>(std::count_if(rows.begin(), rows.end(), [](std::int32_t r) { return r >= 0; })));
+      soup.count_not_kept(
+          fmt::format("OBJ {} indices without any {} statement", what,
+                      std::string_view(what) == "normal" ? "vn" : "vt"),
+          static_cast<std::int64_t>(std::count_if(rows.begin(), rows.end(), [](std::int32_t r) { return r >= 0; })));
       return;
     }
     for (const std::int32_t r : rows)

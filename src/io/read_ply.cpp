@@ -353,7 +353,8 @@ class PlyParser {
   static void fill_channels(ChannelLayout& layout, std::vector<std::vector<double>>& columns,
                             std::vector<AttributeChannel>& out) {
     std::vector<std::vector<std::vector<double>>> per_channel(layout.channels.size());
-    for (std::size_t c = 0; c < layout.channels.size(); ++c) per_channel[c].resize(layout.channels[c].components.size());
+    for (std::size_t c = 0; c < layout.channels.size(); ++c)
+      per_channel[c].resize(layout.channels[c].components.size());
     for (std::size_t i = 0; i < columns.size(); ++i) {
       const auto [channel, component] = layout.slot[i];
       per_channel[static_cast<std::size_t>(channel)][static_cast<std::size_t>(component)] = std::move(columns[i]);

@@ -521,11 +521,15 @@ void write_obj(Output& out, const Mesh& mesh, const WriteOptions& options) {
       Label label;
       label.channel = c;
       label.keyword = c->name == "object" ? "o" : c->name == "group" ? "g" : c->name == "material" ? "usemtl" : "s";
-      label.names = c->name == "object" ? &a.objects : c->name == "group" ? &a.groups : c->name == "material" ? &a.materials : nullptr;
+      label.names = c->name == "object"     ? &a.objects
+                    : c->name == "group"    ? &a.groups
+                    : c->name == "material" ? &a.materials
+                                            : nullptr;
       labels.push_back(label);
     }
   }
-  auto corner_row = [&](const CornerChannel* corner, const AttributeChannel* per_vertex, Index f, int k) -> std::int64_t {
+  auto corner_row = [&](const CornerChannel* corner, const AttributeChannel* per_vertex, Index f,
+                        int k) -> std::int64_t {
     if (corner) return corner->corners(f, k);
     return per_vertex ? mesh.F(f, k) : -1;
   };
@@ -619,12 +623,15 @@ void write_ply(Output& out, const Mesh& mesh, const WriteOptions& options) {
   b += fmt::format("element vertex {}\nproperty {} x\nproperty {} y\nproperty {} z\n", mesh.num_vertices(), coordinate,
                    coordinate, coordinate);
   for (const AttributeChannel* c : w.vertex)
-    for (const std::string& component : c->components) b += fmt::format("property {} {}\n", ply_type_name(c->type), component);
+    for (const std::string& component : c->components)
+      b += fmt::format("property {} {}\n", ply_type_name(c->type), component);
   b += fmt::format("element face {}\nproperty list uchar int vertex_indices\n", mesh.num_faces());
   for (const AttributeChannel* c : w.face)
-    for (const std::string& component : c->components) b += fmt::format("property {} {}\n", ply_type_name(c->type), component);
-  if (texcoord) b += fmt::format("property list uchar {} {}\n", ply_type_name(texcoord->type),
-                                 texcoord->name == "uv" ? "texcoord" : texcoord->name);
+    for (const std::string& component : c->components)
+      b += fmt::format("property {} {}\n", ply_type_name(c->type), component);
+  if (texcoord)
+    b += fmt::format("property list uchar {} {}\n", ply_type_name(texcoord->type),
+                     texcoord->name == "uv" ? "texcoord" : texcoord->name);
   b += "end_header\n";
   // A corner without a texture coordinate (OBJ `f 1 2/3 4`) is written as (0, 0).
   auto texcoord_value = [&](Index f, int k, int c) {

@@ -66,6 +66,30 @@ TEST(CliInfo, MissingFileIsOneLineErrorAndExitCode1) {
   EXPECT_TRUE(r.out.empty());
 }
 
+// Nothing is dropped without a word (issue 28): enhance writes spot's texture coordinates to OBJ
+// and says what STL cannot hold; remesh names what it does not carry.
+TEST(CliAttributes, EnhanceCarriesThemAndEveryDropIsNamed) {
+  test::ScratchDir dir("cli-attributes");
+  const auto obj = run_cli("enhance " + quoted_data_path("spot.obj") + " " + test::quoted(dir.file("out.obj")));
+  ASSERT_EQ(obj.exit_code, 0) << obj.err;
+  EXPECT_EQ(obj.err.find("warning"), std::string::npos) << obj.err;
+  const Mesh out = read_mesh(dir.file("out.obj"));
+  const Mesh spot = read_mesh(test::data_path("spot.obj"));
+  ASSERT_NE(out.attributes.find_corner("uv"), nullptr);
+  EXPECT_EQ(out.attributes.find_corner("uv")->corners, spot.attributes.find_corner("uv")->corners);
+  EXPECT_EQ(out.F, spot.F);
+  const auto stl = run_cli("enhance " + quoted_data_path("spot.obj") + " " + test::quoted(dir.file("out.stl")));
+  ASSERT_EQ(stl.exit_code, 0) << stl.err;
+  EXPECT_NE(stl.err.find("out.stl: STL cannot hold, so it does not get: corner uv"), std::string::npos) << stl.err;
+  const auto remesh = run_cli("remesh " + quoted_data_path("spot.obj") + " " + test::quoted(dir.file("r.obj")) +
+                              " --target-vertices 1000");
+  ASSERT_EQ(remesh.exit_code, 0) << remesh.err;
+  EXPECT_NE(
+      remesh.err.find("remesh builds new faces and vertices and does not carry the input's attributes: corner uv"),
+      std::string::npos)
+      << remesh.err;
+}
+
 TEST(Cli, UsageErrorsFail) {
   EXPECT_NE(run_cli("").exit_code, 0);
   EXPECT_NE(run_cli("info").exit_code, 0);

@@ -9,12 +9,14 @@
 
 #include <gtest/gtest.h>
 
-#include <cmath>
+#include <algorithm>
 #include <array>
+#include <cmath>
 #include <functional>
 #include <map>
-#include <optional>
 #include <numbers>
+#include <optional>
+#include <set>
 
 namespace vertexflow {
 namespace {
@@ -33,7 +35,7 @@ Parametric parametric(int nu, int nv, bool wrap_v, const std::function<Eigen::Ve
   Parametric p;
   Mesh& m = p.mesh;
   const bool poles = !wrap_v;
-  const int rows = wrap_v ? nv : nv - 1;  // rows of shared vertices (poles apart)
+  const int rows = wrap_v ? nv : nv - 1;      // rows of shared vertices (poles apart)
   auto vertex = [&](int i, int j) -> Index {  // i mod nu; j in 0..nv
     i = (i % nu + nu) % nu;
     if (wrap_v) return static_cast<Index>((j % nv) * nu + i);
@@ -126,9 +128,9 @@ std::optional<SurfacePoint> surface_at(const Mesh& input, const Eigen::Vector2d&
     const double b1 = (d.x() * e2.y() - d.y() * e2.x()) / det, b2 = (e1.x() * d.y() - e1.y() * d.x()) / det;
     const double tolerance = -1e-9;
     if (b1 < tolerance || b2 < tolerance || 1 - b1 - b2 < tolerance) continue;
-    const Eigen::Vector3d point = ((1 - b1 - b2) * input.V.row(input.F(f, 0)) + b1 * input.V.row(input.F(f, 1)) +
-                                   b2 * input.V.row(input.F(f, 2)))
-                                      .transpose();
+    const Eigen::Vector3d point =
+        ((1 - b1 - b2) * input.V.row(input.F(f, 0)) + b1 * input.V.row(input.F(f, 1)) + b2 * input.V.row(input.F(f, 2)))
+            .transpose();
     return SurfacePoint{point, face_normal(input.V, input.F, f).normalized()};
   }
   return std::nullopt;
@@ -303,6 +305,59 @@ TEST(Spot, TextureCoordinatesAreResampledNotKept) {
   const CornerChannel& after = result.mesh.attributes.corner.front();
   EXPECT_EQ(after.corners.rows(), before.corners.rows());
   EXPECT_FALSE(after.channel.values == before.channel.values);
+}
+
+}  // namespace
+}  // namespace vertexflow
+
+namespace vertexflow {
+namespace {
+
+TEST(EdgeFlips, NeverFlipASeamAndKeepEveryCornerInItsChart) {
+  const Mesh spot = read_mesh(test::data_path("spot.obj"));
+  EnhanceOptions options;
+  options.edge_flips = true;
+  const EnhanceResult result = enhance(spot, nullptr, options);
+  const Mesh& out = result.mesh;
+  const Topology before = build_topology(spot.F, spot.num_vertices());
+  const Topology after = build_topology(out.F, out.num_vertices());
+  Index changed = 0;
+  for (Index f = 0; f < spot.num_faces(); ++f) changed += out.F.row(f) != spot.F.row(f);
+  std::printf("[ flips    ] %d faces changed by %d flips\n", static_cast<int>(changed),
+              result.report["edge_flips"]["flips"].get<int>());
+  ASSERT_GT(changed, 100);  // the flips happened (measured: 1060 faces by 536 flips)
+  // Every seam edge of the input is still an edge: a flip removes the edge it flips.
+  const CornerChannel& uv = spot.attributes.corner.front();
+  auto row_at = [](const CornerChannel& c, const Faces& F, Index f, Index v) {
+    for (int k = 0; k < 3; ++k)
+      if (F(f, k) == v) return c.corners(f, k);
+    return -1;
+  };
+  std::set<std::pair<Index, Index>> edges_after;
+  for (Index e = 0; e < after.num_edges(); ++e) edges_after.insert({after.edges(e, 0), after.edges(e, 1)});
+  Index seams = 0;
+  for (Index f = 0; f < spot.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const Index g = before.face_adjacency(f, k);
+      if (g < f) continue;
+      const Index a = spot.F(f, k), b = spot.F(f, (k + 1) % 3);
+      if (row_at(uv, spot.F, f, a) == row_at(uv, spot.F, g, a) && row_at(uv, spot.F, f, b) == row_at(uv, spot.F, g, b))
+        continue;
+      ++seams;
+      EXPECT_TRUE(edges_after.count({std::min(a, b), std::max(a, b)}))
+          << "seam edge " << a << "-" << b << " was flipped";
+    }
+  EXPECT_EQ(seams, result.report["attributes"]["chart_boundary_edges"].get<int>());
+  // A flipped face's corners take rows their vertices have in the input: each row of the
+  // table still belongs to one vertex (no texture coordinate of another vertex taken).
+  const CornerChannel& out_uv = out.attributes.corner.front();
+  std::vector<Index> owner(static_cast<std::size_t>(out_uv.channel.rows()), -1);
+  for (Index f = 0; f < out.num_faces(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const auto r = static_cast<std::size_t>(out_uv.corners(f, k));
+      if (owner[r] == -1) owner[r] = out.F(f, k);
+      EXPECT_EQ(owner[r], out.F(f, k)) << "row " << r;
+    }
 }
 
 }  // namespace

@@ -173,13 +173,14 @@ TEST(AttributesIo, PlyPropertiesOfEveryTypeRoundTripInEveryEncoding) {
   EXPECT_EQ(a.vertex[6].values(0, 0), -2147483648.0);
   EXPECT_EQ(a.vertex[8].values(0, 0), 0.30000000000000004);
   EXPECT_EQ(a.vertex[2].values(0, 0), static_cast<double>(0.1f));  // a float property holds a float
-  ASSERT_EQ(a.face.size(), 3u);  // material, area, color
+  ASSERT_EQ(a.face.size(), 3u);                                    // material, area, color
   EXPECT_EQ(a.face[0].values(1, 0), -3);
   EXPECT_EQ(a.face[2].role, AttributeRole::Color);
   const CornerChannel* texcoord = a.find_corner("texcoord");
   ASSERT_NE(texcoord, nullptr);
   EXPECT_EQ(texcoord->channel.values.row(texcoord->corners(1, 2)), Eigen::RowVector2d(0, 1));
-  for (const PlyEncoding encoding : {PlyEncoding::Ascii, PlyEncoding::BinaryLittleEndian, PlyEncoding::BinaryBigEndian}) {
+  for (const PlyEncoding encoding :
+       {PlyEncoding::Ascii, PlyEncoding::BinaryLittleEndian, PlyEncoding::BinaryBigEndian}) {
     WriteOptions options;
     options.ply_encoding = encoding;
     const auto path = dir.file("out" + std::to_string(static_cast<int>(encoding)) + ".ply");

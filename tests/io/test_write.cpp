@@ -177,7 +177,9 @@ TEST(WriteMesh, PropertyErrorsNameTheFile) {
     write_mesh(dir.file("out.ply"), mesh);
     FAIL();
   } catch (const IoError& e) {
-    EXPECT_EQ(std::string(e.what()).rfind(dir.file("out.ply").string() + ": attributes: vertex channel 'short' has 1 rows for 3 vertices", 0), 0u)
+    EXPECT_EQ(std::string(e.what()).rfind(
+                  dir.file("out.ply").string() + ": attributes: vertex channel 'short' has 1 rows for 3 vertices", 0),
+              0u)
         << e.what();
   }
 }
