@@ -14,9 +14,12 @@
 namespace vertexflow::attributes_detail {
 
 /// Chart boundaries among the faces `faces` of `input` (rows of input.F; `topology` is built
-/// over exactly those rows, in that order, and input.V's vertex count), as vertex pairs.
-std::vector<std::array<Index, 2>> chart_boundaries(const Mesh& input, const std::vector<Index>& faces,
-                                                   const Topology& topology);
+/// over exactly those rows, in that order, and input.V's vertex count).
+struct ChartBoundaries {
+  std::vector<char> on_edge;                ///< per edge of `topology`
+  std::vector<std::array<Index, 2>> edges;  ///< the same edges as vertex pairs
+};
+ChartBoundaries chart_boundaries(const Mesh& input, const std::vector<Index>& faces, const Topology& topology);
 
 struct TransportReport {
   Index vertices_moved = 0;
@@ -41,6 +44,7 @@ struct TransportReport {
 /// input's split (corners sharing a row are averaged together) and orientation kept. Vertices
 /// that did not move keep their values exactly.
 MeshAttributes transport_attributes(const Mesh& input, const std::vector<Index>& faces, const Topology& topology,
-                                    const Vertices& moved, const Faces& output_F, TransportReport& report);
+                                    const ChartBoundaries& charts, const Vertices& moved, const Faces& output_F,
+                                    TransportReport& report);
 
 }  // namespace vertexflow::attributes_detail

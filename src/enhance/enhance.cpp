@@ -136,10 +136,11 @@ struct MethodRun {
 };
 
 MethodRun run_flow(const Mesh& mesh, const ReferenceSurface* reference, const FlowOptions& options,
-                   const EnhanceCallbacks& callbacks, const Warnings& warn) {
+                   const EnhanceCallbacks& callbacks, const Warnings& warn, const Topology* topology) {
   FlowResult result = reference
                           ? vertex_flow_on_reference(mesh.V, mesh.F, reference->vertices(), reference->faces(), options)
-                          : vertex_flow(mesh.V, mesh.F, build_topology(mesh.F, mesh.num_vertices()), options);
+                      : topology ? vertex_flow(mesh.V, mesh.F, *topology, options)
+                                 : vertex_flow(mesh.V, mesh.F, build_topology(mesh.F, mesh.num_vertices()), options);
   const FlowReport& r = result.report;
   tell(callbacks.phase, fmt::format("curvature {:.3f} s, assembly {:.3f} s, solve {:.3f} s, projection {:.3f} s, "
                                     "guard {:.3f} s; {} vertices limited by the guard",
@@ -367,9 +368,10 @@ void validate_enhance_options(const EnhanceOptions& options, bool has_reference,
 namespace {
 
 // The engine on a mesh whose faces all have three distinct vertices, positive area and no
-// duplicate, and whose vertices all have faces; attributes are left to enhance().
+// duplicate, and whose vertices all have faces; attributes are left to enhance(). `topology`, when
+// given, is the mesh's (build_topology), for the flow.
 EnhanceResult enhance_clean(const Mesh& mesh, const ReferenceSurface* reference, const EnhanceOptions& options,
-                            const EnhanceCallbacks& callbacks) {
+                            const EnhanceCallbacks& callbacks, const Topology* topology = nullptr) {
   // Trees over the reference's faces this run builds (its own, or any step's copy): one is the
   // promise of reference_surface.h, the flow on S's own tree a second (flow.h).
   const std::uint64_t trees_before = reference ? distance_trees_built(reference->faces().rows()) : 0;
@@ -420,10 +422,10 @@ EnhanceResult enhance_clean(const Mesh& mesh, const ReferenceSurface* reference,
       run = run_unsharp(mesh, effective_unsharp_options(options), warn);
       break;
     case EnhanceMode::ReferenceFlow:
-      run = run_flow(mesh, reference, flow, callbacks, warn);
+      run = run_flow(mesh, reference, flow, callbacks, warn, nullptr);
       break;
     case EnhanceMode::Flow:
-      run = run_flow(mesh, nullptr, flow, callbacks, warn);
+      run = run_flow(mesh, nullptr, flow, callbacks, warn, topology);
       break;
   }
 
@@ -463,18 +465,36 @@ std::vector<Index> workable_faces(const Mesh& mesh) {
   const auto m = static_cast<std::size_t>(mesh.num_faces());
   std::vector<char> out(m, 0);
   for (const Index f : degenerate_faces(mesh.V, mesh.F)) out[static_cast<std::size_t>(f)] = 1;
-  // Repeats: faces sorted by their sorted corners; each but the first of a run is out.
-  std::vector<std::pair<std::array<Index, 3>, Index>> keys(m);
+  // Repeats: faces bucketed by their smallest vertex (a counting sort, linear time; a full sort
+  // of the keys was a tenth of the engine's own time on a 10k mesh), then compared within their
+  // bucket; each but the first of equal faces is out.
+  std::vector<std::array<Index, 3>> keys(m);
+  std::vector<Index> start(static_cast<std::size_t>(mesh.num_vertices()) + 1, 0);
   for (std::size_t f = 0; f < m; ++f) {
-    std::array<Index, 3> key{mesh.F(static_cast<Index>(f), 0), mesh.F(static_cast<Index>(f), 1),
-                             mesh.F(static_cast<Index>(f), 2)};
+    std::array<Index, 3>& key = keys[f];
+    key = {mesh.F(static_cast<Index>(f), 0), mesh.F(static_cast<Index>(f), 1), mesh.F(static_cast<Index>(f), 2)};
     std::sort(key.begin(), key.end());
     if (key[0] == key[1] || key[1] == key[2]) out[f] = 1;
-    keys[f] = {key, static_cast<Index>(f)};
+    ++start[static_cast<std::size_t>(key[0]) + 1];
   }
-  std::sort(keys.begin(), keys.end());
-  for (std::size_t i = 1; i < m; ++i)
-    if (keys[i].first == keys[i - 1].first) out[static_cast<std::size_t>(keys[i].second)] = 1;
+  for (std::size_t v = 1; v < start.size(); ++v) start[v] += start[v - 1];
+  std::vector<Index> order(m);
+  {
+    std::vector<Index> fill(start.begin(), start.end() - 1);
+    for (std::size_t f = 0; f < m; ++f)
+      order[static_cast<std::size_t>(fill[static_cast<std::size_t>(keys[f][0])]++)] = static_cast<Index>(f);
+  }
+  for (std::size_t v = 0; v + 1 < start.size(); ++v) {
+    const auto begin = order.begin() + start[v], end = order.begin() + start[v + 1];
+    if (end - begin < 2) continue;
+    // Faces are in increasing order within a bucket; a stable sort by key keeps the first first.
+    std::stable_sort(begin, end, [&](Index a, Index b) {
+      return keys[static_cast<std::size_t>(a)] < keys[static_cast<std::size_t>(b)];
+    });
+    for (auto it = begin + 1; it != end; ++it)
+      if (keys[static_cast<std::size_t>(*it)] == keys[static_cast<std::size_t>(*(it - 1))])
+        out[static_cast<std::size_t>(*it)] = 1;
+  }
   std::vector<Index> faces;
   faces.reserve(m);
   for (std::size_t f = 0; f < m; ++f)
@@ -528,18 +548,25 @@ EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const
   // Chart boundaries (seams, material boundaries) are creases for the flow and never flipped.
   const Faces workable_F = enhance_detail::face_rows(mesh.F, faces);
   const Topology topology = build_topology(workable_F, n);
-  const std::vector<std::array<Index, 2>> seams = attributes_detail::chart_boundaries(mesh, faces, topology);
+  const attributes_detail::ChartBoundaries charts = attributes_detail::chart_boundaries(mesh, faces, topology);
+  const std::vector<std::array<Index, 2>>& seams = charts.edges;
 
+  // The methods' mesh: the input itself when every face and vertex is workable, else the
+  // workable faces on the vertices they use.
   Mesh work;
-  work.comments = mesh.comments;
+  if (!whole) work.comments = mesh.comments;
+  const Mesh& methods_mesh = whole ? mesh : work;
   EnhanceOptions o = options;
   o.constraints.pinned.clear();
   o.constraints.crease_edges.clear();
-  work.V.resize(static_cast<Eigen::Index>(to_input.size()), 3);
-  for (std::size_t w = 0; w < to_input.size(); ++w) work.V.row(static_cast<Eigen::Index>(w)) = mesh.V.row(to_input[w]);
-  work.F.resize(workable_F.rows(), 3);
-  for (Eigen::Index i = 0; i < workable_F.rows(); ++i)
-    for (int k = 0; k < 3; ++k) work.F(i, k) = to_work[static_cast<std::size_t>(workable_F(i, k))];
+  if (!whole) {
+    work.V.resize(static_cast<Eigen::Index>(to_input.size()), 3);
+    for (std::size_t w = 0; w < to_input.size(); ++w)
+      work.V.row(static_cast<Eigen::Index>(w)) = mesh.V.row(to_input[w]);
+    work.F.resize(workable_F.rows(), 3);
+    for (Eigen::Index i = 0; i < workable_F.rows(); ++i)
+      for (int k = 0; k < 3; ++k) work.F(i, k) = to_work[static_cast<std::size_t>(workable_F(i, k))];
+  }
   for (const Index p : options.constraints.pinned)
     if (to_work[static_cast<std::size_t>(p)] >= 0) o.constraints.pinned.push_back(to_work[static_cast<std::size_t>(p)]);
   Index vertices_held = 0;
@@ -556,15 +583,21 @@ EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const
   for (const auto& [a, b] : seams)
     o.constraints.crease_edges.push_back({to_work[static_cast<std::size_t>(a)], to_work[static_cast<std::size_t>(b)]});
 
-  EnhanceResult result = enhance_clean(work, reference, o, callbacks);
+  // The topology built for the seams is the flow's too when the methods work on the input.
+  EnhanceResult result = enhance_clean(methods_mesh, reference, o, callbacks, whole ? &topology : nullptr);
   Mesh out;
-  out.V = mesh.V;
-  for (std::size_t w = 0; w < to_input.size(); ++w)
-    out.V.row(to_input[w]) = result.mesh.V.row(static_cast<Eigen::Index>(w));
-  out.F = mesh.F;
-  for (std::size_t i = 0; i < faces.size(); ++i)
-    for (int k = 0; k < 3; ++k)
-      out.F(faces[i], k) = to_input[static_cast<std::size_t>(result.mesh.F(static_cast<Eigen::Index>(i), k))];
+  if (whole) {
+    out.V = std::move(result.mesh.V);
+    out.F = std::move(result.mesh.F);
+  } else {
+    out.V = mesh.V;
+    for (std::size_t w = 0; w < to_input.size(); ++w)
+      out.V.row(to_input[w]) = result.mesh.V.row(static_cast<Eigen::Index>(w));
+    out.F = mesh.F;
+    for (std::size_t i = 0; i < faces.size(); ++i)
+      for (int k = 0; k < 3; ++k)
+        out.F(faces[i], k) = to_input[static_cast<std::size_t>(result.mesh.F(static_cast<Eigen::Index>(i), k))];
+  }
   out.comments = std::move(result.mesh.comments);
   const Index faces_held = mesh.num_faces() - static_cast<Index>(faces.size());
   if (faces_held > 0) {
@@ -581,7 +614,7 @@ EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const
   if (!mesh.attributes.empty()) {
     const auto start = Clock::now();
     attributes_detail::TransportReport t;
-    out.attributes = attributes_detail::transport_attributes(mesh, faces, topology, out.V, out.F, t);
+    out.attributes = attributes_detail::transport_attributes(mesh, faces, topology, charts, out.V, out.F, t);
     result.report["attributes"] = {
         {"chart_boundary_edges", seams.size()}, {"vertices_moved", t.vertices_moved},
         {"wedges_located", t.wedges_located},   {"max_location_distance_edges", t.max_location_distance},
