@@ -266,7 +266,10 @@ void finish_attributes(ObjAttributes& obj, PolygonSoup& soup, const std::string&
   label("object", obj.object, obj.has_object, -1);
   label("group", obj.group, obj.has_group, -1);
   label("material", obj.material, obj.has_material, -1);
-  label("smoothing", obj.smoothing, obj.has_smoothing, 0);
+  // "s off" alone (Blender writes it before every object) is the default: no channel of zeros.
+  const bool any_smoothing = std::any_of(obj.smoothing.begin(), obj.smoothing.end(), [](double g) { return g != 0; }) ||
+                             obj.current_smoothing != 0;
+  label("smoothing", obj.smoothing, obj.has_smoothing && any_smoothing, 0);
 }
 
 }  // namespace
