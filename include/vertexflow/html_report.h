@@ -56,7 +56,9 @@ struct HtmlReportOptions {
 /// stays per vertex. `metrics_json` is a JSON object shown as the metrics table (nested
 /// objects become dotted names; {"input": a, "result": b} pairs and NAME_input / NAME_result
 /// keys become one row with two columns), e.g. the JSON of `vertexflow enhance --report`;
-/// an empty string gives an empty table. Throws std::invalid_argument when the vertex or face
+/// an empty string gives an empty table. When both meshes have texture coordinates (the first
+/// TexCoord channel, attributes.h), the page also has a checker-texture view of each, as
+/// `render --texture checker` draws it. Throws std::invalid_argument when the vertex or face
 /// counts differ, a result face has a corner that is not a vertex, a mesh is not manifold
 /// (curvature.h), or metrics_json is not a JSON object.
 std::string html_report(const Mesh& input, const Mesh& result, std::string_view metrics_json,

@@ -205,7 +205,8 @@ struct RenderInfo {
 
 /// Renders `mesh` off-screen. Throws std::invalid_argument for bad options (size out of range,
 /// a displacement reference of the wrong size, exaggerated shading's options or light out of
-/// range) and
+/// range, checker_squares outside [1, 256], RenderTexture::Checker on a mesh without texture
+/// coordinates) and
 /// std::runtime_error when OSMesa cannot create a context or the legend font cannot be loaded.
 /// Deterministic: the same mesh and options give the same pixels.
 Image render_mesh(const Mesh& mesh, const RenderOptions& options = {}, RenderInfo* info = nullptr);
