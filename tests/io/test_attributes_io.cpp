@@ -2,6 +2,7 @@
 // reproduces every channel's name, components, type, order and values; OBJ's texture
 // coordinates, normals, materials, groups and smoothing groups; the face list as the file has
 // it (ReadOptions::keep_face_list).
+#include "attribute_checks.h"
 #include "test_support.h"
 
 #include "vertexflow/io.h"
@@ -18,35 +19,6 @@ void write_bytes(const std::filesystem::path& path, const std::string& bytes) {
   std::ofstream(path, std::ios::binary) << bytes;
 }
 
-void expect_same_channel(const AttributeChannel& a, const AttributeChannel& b) {
-  EXPECT_EQ(a.name, b.name);
-  EXPECT_EQ(a.components, b.components) << a.name;
-  EXPECT_EQ(a.type, b.type) << a.name;
-  EXPECT_EQ(a.role, b.role) << a.name;
-  ASSERT_EQ(a.values.rows(), b.values.rows()) << a.name;
-  ASSERT_EQ(a.values.cols(), b.values.cols()) << a.name;
-  EXPECT_TRUE(a.values == b.values) << a.name;  // exact: doubles hold every type's values
-}
-
-void expect_same_attributes(const Mesh& a, const Mesh& b) {
-  EXPECT_EQ(a.V, b.V);
-  EXPECT_EQ(a.F, b.F);
-  const MeshAttributes &x = a.attributes, &y = b.attributes;
-  ASSERT_EQ(x.vertex.size(), y.vertex.size());
-  for (std::size_t i = 0; i < x.vertex.size(); ++i) expect_same_channel(x.vertex[i], y.vertex[i]);
-  ASSERT_EQ(x.face.size(), y.face.size());
-  for (std::size_t i = 0; i < x.face.size(); ++i) expect_same_channel(x.face[i], y.face[i]);
-  ASSERT_EQ(x.corner.size(), y.corner.size());
-  for (std::size_t i = 0; i < x.corner.size(); ++i) {
-    expect_same_channel(x.corner[i].channel, y.corner[i].channel);
-    EXPECT_EQ(x.corner[i].corners, y.corner[i].corners);
-  }
-  EXPECT_EQ(x.materials, y.materials);
-  EXPECT_EQ(x.groups, y.groups);
-  EXPECT_EQ(x.objects, y.objects);
-  EXPECT_EQ(x.material_libraries, y.material_libraries);
-}
-
 TEST(AttributesIo, SpotObjKeepsItsTextureCoordinatesThroughObjAndPly) {
   const Mesh spot = read_mesh(test::data_path("spot.obj"));
   const CornerChannel* uv = spot.attributes.find_corner("uv");
@@ -59,7 +31,7 @@ TEST(AttributesIo, SpotObjKeepsItsTextureCoordinatesThroughObjAndPly) {
   EXPECT_EQ(uv->corners.row(0), (Eigen::Matrix<std::int32_t, 1, 3>(0, 1, 2)));
   test::ScratchDir dir("attributes-spot");
   write_mesh(dir.file("spot.obj"), spot);
-  expect_same_attributes(spot, read_mesh(dir.file("spot.obj")));
+  test::expect_same_attributes(spot, read_mesh(dir.file("spot.obj")));
   EXPECT_TRUE(attributes_not_written(spot, MeshFormat::Obj).empty());
   // PLY holds per-corner texture coordinates as MeshLab's face `texcoord` lists: the values at
   // every corner survive (the table becomes one row per corner).
@@ -84,7 +56,7 @@ TEST(AttributesIo, SuzanneObjKeepsNormalsMaterialObjectAndLibrary) {
   EXPECT_EQ(suzanne.attributes.material_libraries, std::vector<std::string>{"affe.mtl"});
   test::ScratchDir dir("attributes-suzanne");
   write_mesh(dir.file("s.obj"), suzanne);
-  expect_same_attributes(suzanne, read_mesh(dir.file("s.obj")));
+  test::expect_same_attributes(suzanne, read_mesh(dir.file("s.obj")));
 }
 
 // An OBJ with every statement a face carries, polygons and a mix of corner forms.
@@ -124,7 +96,7 @@ TEST(AttributesIo, ObjStatementsRoundTripAndFollowTheTriangulation) {
   EXPECT_EQ(uv->corners.row(2), (Eigen::Matrix<std::int32_t, 1, 3>(-1, -1, -1)));
   EXPECT_EQ(uv->corners.row(3), (Eigen::Matrix<std::int32_t, 1, 3>(3, 4, 0)));  // negative indices
   write_mesh(dir.file("out.obj"), mesh);
-  expect_same_attributes(mesh, read_mesh(dir.file("out.obj")));
+  test::expect_same_attributes(mesh, read_mesh(dir.file("out.obj")));
   // A face index past the table is an error naming the file.
   write_bytes(dir.file("bad.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nf 1/1 2/2 3/1\n");
   try {
@@ -187,7 +159,7 @@ TEST(AttributesIo, PlyPropertiesOfEveryTypeRoundTripInEveryEncoding) {
     write_mesh(path, mesh, options);
     const Mesh back = read_mesh(path);
     SCOPED_TRACE(static_cast<int>(encoding));
-    expect_same_attributes(mesh, back);
+    test::expect_same_attributes(mesh, back);
   }
   // An integer property's ASCII value must fit its type.
   std::string bad = every_type_ply("ascii") + kEveryTypeBody;

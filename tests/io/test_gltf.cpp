@@ -2,6 +2,7 @@
 // written and read again with every channel, face and image the same; vertices welded by
 // position; skins kept and skin weights normalised after enhance moved the vertices; a mesh
 // from OBJ written as a fresh document; compressed and non-triangle content reported.
+#include "attribute_checks.h"
 #include "gltf.h"
 #include "test_support.h"
 
@@ -30,31 +31,6 @@ const tinygltf::Model& model_of(const Mesh& mesh) {
   return mesh.attributes.gltf->model;
 }
 
-void expect_same_channel(const AttributeChannel& a, const AttributeChannel& b) {
-  EXPECT_EQ(a.name, b.name);
-  EXPECT_EQ(a.components, b.components) << a.name;
-  EXPECT_EQ(a.type, b.type) << a.name;
-  EXPECT_EQ(a.role, b.role) << a.name;
-  ASSERT_EQ(a.values.rows(), b.values.rows()) << a.name;
-  ASSERT_EQ(a.values.cols(), b.values.cols()) << a.name;
-  EXPECT_TRUE(a.values == b.values) << a.name;
-}
-
-void expect_same_mesh(const Mesh& a, const Mesh& b) {
-  EXPECT_TRUE(a.V == b.V);
-  EXPECT_TRUE(a.F == b.F);
-  ASSERT_EQ(a.attributes.corner.size(), b.attributes.corner.size());
-  for (std::size_t i = 0; i < a.attributes.corner.size(); ++i) {
-    expect_same_channel(a.attributes.corner[i].channel, b.attributes.corner[i].channel);
-    EXPECT_TRUE(a.attributes.corner[i].corners == b.attributes.corner[i].corners)
-        << a.attributes.corner[i].channel.name;
-  }
-  ASSERT_EQ(a.attributes.face.size(), b.attributes.face.size());
-  for (std::size_t i = 0; i < a.attributes.face.size(); ++i)
-    expect_same_channel(a.attributes.face[i], b.attributes.face[i]);
-  EXPECT_EQ(a.attributes.materials, b.attributes.materials);
-}
-
 using Sample = std::tuple<std::string, std::string>;  // input under data/, output extension
 
 class GltfRoundTrip : public ::testing::TestWithParam<Sample> {};
@@ -70,7 +46,7 @@ TEST_P(GltfRoundTrip, EveryChannelFaceAndImageComesBackTheSame) {
   ReadReport report;
   const Mesh back = read_mesh(out, &report, keep_faces());
   EXPECT_EQ(report.binary, extension == ".glb");
-  expect_same_mesh(mesh, back);
+  test::expect_same_attributes(mesh, back);
   const tinygltf::Model &a = model_of(mesh), &b = model_of(back);
   ASSERT_EQ(a.images.size(), b.images.size());
   for (std::size_t i = 0; i < a.images.size(); ++i) EXPECT_TRUE(a.images[i].image == b.images[i].image) << i;
