@@ -10,8 +10,11 @@
 // show a mesh (pixels that are not background), each view draws its own mesh's display faces,
 // and on the first report: the wireframe toggle and each colour map change both views, the
 // curvature map has red and blue, and dragging the input view turns the result view too; on
-// the edge-flip report: the per-face quality map changes both views. Prints one line per check
-// and "N passed, M failed"; exit 1 on a failure.
+// the edge-flip report: the per-face quality map changes both views. Two more reports of spot
+// (texture coordinates), full and decimated: the checker-texture toggle and its squares box
+// change both views and unchecking takes the texture off; fandisk's reports (no texture
+// coordinates) hide the checker controls. Prints one line per check and "N passed, M failed";
+// exit 1 on a failure.
 import { execFileSync } from 'node:child_process';
 import { statSync } from 'node:fs';
 import path from 'node:path';
@@ -34,6 +37,12 @@ run('enhance', mesh, enhanced, '--html', fullReport);
 run('report', mesh, enhanced, decimatedReport, '--max-display-faces', '3000');
 run('enhance', mesh, flipped, '--edge-flips', '--html', flipsReport);
 run('report', mesh, flipped, flipsDecimatedReport, '--max-display-faces', '3000');
+const spot = path.join(dataDir, 'spot.obj');
+const spotEnhanced = path.join(work, 'spot_enhanced.obj');
+const spotReport = path.join(work, 'spot.html');
+const spotDecimatedReport = path.join(work, 'spot_decimated.html');
+run('enhance', spot, spotEnhanced, '--html', spotReport);
+run('report', spot, spotEnhanced, spotDecimatedReport, '--max-display-faces', '2000');
 
 // One screenshot of the strip holding both canvases (few screenshots: each costs a software
 // render and a PNG round trip), and where each canvas lies in it.
@@ -100,7 +109,7 @@ async function afterRedraw(page, action) {
 
 const VIEWS = ['input', 'result'];
 
-async function testReport(browser, file, { decimated, interact, ownFaces, quality = false }) {
+async function testReport(browser, file, { decimated, interact, ownFaces, quality = false, checker = false }) {
   const name = path.basename(file);
   const { context, page, requests, errors } = await offlinePage(browser, { width: 900, height: 700 });
 
@@ -127,6 +136,9 @@ async function testReport(browser, file, { decimated, interact, ownFaces, qualit
     `${name}: each view draws its own mesh's faces`, `drawn ${drawn}`);
 
   if (interact) await testInteraction(page, name, plain);
+  const controls = await page.locator('#checker-controls').isVisible();
+  check(controls === checker, `${name}: checker-texture controls ${checker ? 'shown' : 'hidden'}`);
+  if (checker) await testChecker(page, name, plain);
   if (quality) {
     await afterRedraw(page, () => page.locator('#colormap').selectOption('quality'));
     const stats = await analyse(page, await shoot(page, `${name}.quality`), plain);
@@ -178,6 +190,27 @@ async function testInteraction(page, name, plain) {
   check(changedBoth(turned), `${name}: dragging the input view turns both views`, `${changes(turned)} pixels changed`);
 }
 
+// The checker texture (render --texture checker's view): toggling it, and changing its squares,
+// change both views; unchecking it gives the plain picture back.
+async function testChecker(page, name, plain) {
+  const changedBoth = (stats) => stats.every((s) => s.changed > 0.05 * s.foreground);
+  const changes = (stats) => stats.map((s) => s.changed).join(' and ');
+  await afterRedraw(page, () => page.locator('#checker').check());
+  const textured = await shoot(page, `${name}.checker`);
+  const on = await analyse(page, textured, plain);
+  check(changedBoth(on), `${name}: checker texture changes both views`, `${changes(on)} pixels changed`);
+  await afterRedraw(page, async () => {
+    await page.locator('#checker-squares').fill('4');
+    await page.locator('#checker-squares').dispatchEvent('change');
+  });
+  const coarse = await analyse(page, await shoot(page, `${name}.checker4`), textured);
+  check(changedBoth(coarse), `${name}: checker squares change both views`, `${changes(coarse)} pixels changed`);
+  await afterRedraw(page, () => page.locator('#checker').uncheck());
+  const off = await analyse(page, await shoot(page, `${name}.checker-off`), plain);
+  check(off.every((s) => s.changed < 0.01 * s.total), `${name}: unchecking gives the plain picture back`,
+    `${changes(off)} pixels differ`);
+}
+
 // Root (as in CI) needs --no-sandbox; SwiftShader gives WebGL without a GPU; a small /dev/shm
 // (containers) must not starve the renderer.
 const browser = await chromium.launch({
@@ -190,6 +223,8 @@ try {
   await testReport(browser, decimatedReport, { decimated: true, interact: false, ownFaces: false });
   await testReport(browser, flipsReport, { decimated: false, interact: false, ownFaces: true, quality: true });
   await testReport(browser, flipsDecimatedReport, { decimated: true, interact: false, ownFaces: true });
+  await testReport(browser, spotReport, { decimated: false, interact: false, ownFaces: false, checker: true });
+  await testReport(browser, spotDecimatedReport, { decimated: true, interact: false, ownFaces: false, checker: true });
 } catch (error) {
   check(false, 'browser test ran to the end', error.stack ?? String(error));
 } finally {
