@@ -38,6 +38,16 @@ void py_write_mesh(const std::filesystem::path& path, const py::handle& V, const
     options.ply_encoding = PlyEncoding::Ascii;
     options.stl_binary = false;
   }
+  // What the format cannot hold is named, as the CLI does (one UserWarning), never dropped
+  // without a word.
+  const std::vector<std::string> lost = attributes_not_written(mesh, format_from_path(path), options);
+  if (!lost.empty()) {
+    std::string list;
+    for (const std::string& item : lost) list += (list.empty() ? "" : ", ") + item;
+    const std::string message =
+        path.string() + ": " + format_name(format_from_path(path)) + " cannot hold, so it does not get: " + list;
+    if (PyErr_WarnEx(PyExc_UserWarning, message.c_str(), 1) != 0) throw py::error_already_set();
+  }
   py::gil_scoped_release release;
   write_mesh(path, mesh, options);
 }
@@ -78,7 +88,7 @@ comment lines (PLY, OBJ, ASCII OFF; STL and binary OFF have none). attributes, a
 read_mesh(attributes=True) returns it (MeshAttributes), is written with its channels' names,
 types and order where the format holds them (PLY every vertex and face channel and one texture
 coordinate per corner, OBJ texture coordinates, normals, materials, groups, objects; io.h's
-attributes_not_written); what the format cannot hold is left out. A glTF output is written as
+attributes_not_written); what the format cannot hold is left out, named in one UserWarning. A glTF output is written as
 one primitive: the input document is not carried (enhance_file and batch carry it). Raises
 ValueError for bad arrays or attributes (naming the key), OSError for file problems.)doc");
 }

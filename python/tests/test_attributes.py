@@ -4,6 +4,8 @@ returns them re-sampled, and a bad dict raises ValueError naming its problem."""
 
 import re
 
+import warnings
+
 import numpy as np
 import pytest
 
@@ -218,3 +220,12 @@ def test_a_bad_dict_raises_value_error_naming_the_problem(tmp_path, case):
 def test_attributes_must_be_a_dict():
     with pytest.raises(ValueError, match=r"^attributes must be a dict, got list"):
         vertexflow.write_mesh("never.ply", V_TET, F_TET, attributes=[])
+
+
+def test_write_mesh_names_what_the_format_cannot_hold(tmp_path):
+    V, F, attributes = vertexflow.read_mesh(DATA / "spot.obj", attributes=True)
+    with pytest.warns(UserWarning, match=r"STL cannot hold, so it does not get: corner uv"):
+        vertexflow.write_mesh(tmp_path / "spot.stl", V, F, attributes=attributes)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # OBJ holds spot's texture coordinates: no warning
+        vertexflow.write_mesh(tmp_path / "spot.obj", V, F, attributes=attributes)
