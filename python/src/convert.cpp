@@ -162,10 +162,11 @@ AttributeChannel channel_from_python(const py::handle& object, const std::string
                             : checked_dict(object, name, {"name", "components", "type", "role", "values"});
   AttributeChannel c;
   c.name = str_value(d, "name", key_of(name, "name"));
-  if (d.contains("type")) c.type = named_enum(str_value(d, "type", key_of(name, "type")), kScalarTypes,
-                                              &scalar_type_name, key_of(name, "type"));
-  if (d.contains("role")) c.role = named_enum(str_value(d, "role", key_of(name, "role")), kRoles,
-                                              &attribute_role_name, key_of(name, "role"));
+  if (d.contains("type"))
+    c.type =
+        named_enum(str_value(d, "type", key_of(name, "type")), kScalarTypes, &scalar_type_name, key_of(name, "type"));
+  if (d.contains("role"))
+    c.role = named_enum(str_value(d, "role", key_of(name, "role")), kRoles, &attribute_role_name, key_of(name, "role"));
 
   const std::string values_name = key_of(name, "values");
   if (!d.contains("values")) throw py::value_error(values_name + " is missing");
@@ -183,8 +184,8 @@ AttributeChannel channel_from_python(const py::handle& object, const std::string
       const double v = c.values.data()[i];
       if (to_scalar_type(v, c.type) != v)
         throw py::value_error(values_name + " has " + py::str(py::float_(v)).cast<std::string>() + " (row " +
-                              std::to_string(i / width) + "), not an integer that " +
-                              scalar_type_name(c.type) + " holds");
+                              std::to_string(i / width) + "), not an integer that " + scalar_type_name(c.type) +
+                              " holds");
     }
   }
 
@@ -218,8 +219,8 @@ CornerChannel corner_from_python(const py::handle& object, const std::string& na
   const Int64Array corners = Int64Array::ensure(a);
   if (!corners) throw py::error_already_set();
   if (corners.ndim() != 2 || corners.shape(1) != 3 || corners.shape(0) != num_faces)
-    throw py::value_error(corners_name + " must have shape (" + std::to_string(num_faces) + ", 3) (one row per face), got " +
-                          std::string(py::str(py::getattr(corners, "shape"))));
+    throw py::value_error(corners_name + " must have shape (" + std::to_string(num_faces) +
+                          ", 3) (one row per face), got " + std::string(py::str(py::getattr(corners, "shape"))));
   const std::int64_t rows = c.channel.rows();
   for (py::ssize_t i = 0; i < corners.size(); ++i)
     if (corners.data()[i] < -1 || corners.data()[i] >= rows)
@@ -259,8 +260,8 @@ MeshAttributes attributes_from_python(const py::handle& object, std::int64_t num
   MeshAttributes attributes;
   if (object.is_none()) return attributes;
   const std::string top = name;
-  const py::dict d = checked_dict(
-      object, top, {"vertex", "corner", "face", "materials", "groups", "objects", "material_libraries"});
+  const py::dict d =
+      checked_dict(object, top, {"vertex", "corner", "face", "materials", "groups", "objects", "material_libraries"});
   const auto channels = [&](const char* key) {
     std::vector<py::handle> items = sequence_items(d, key, key_of(top, key));
     return items;

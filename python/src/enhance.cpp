@@ -155,7 +155,8 @@ void register_enhance(py::module_& m) {
   m.attr("_FACES_OPTION") = faces_option();
   m.def("_enhance", &py_enhance, py::arg("V"), py::arg("F"), py::arg("options"), py::arg("reference") = py::none(),
         py::arg("provenance") = py::none(), py::arg("attributes") = py::none(), py::arg("threads") = 0,
-        py::arg("progress") = py::none(), "vertexflow.enhance's work: options is {keyword: value} of the keywords given.");
+        py::arg("progress") = py::none(),
+        "vertexflow.enhance's work: options is {keyword: value} of the keywords given.");
   m.def("_enhance_options", &py_enhance_options, py::arg("options"), py::arg("has_reference") = false,
         py::arg("naming") = "python", "vertexflow.enhance_options's work.");
   m.def("_time_vertex_flow", &py_time_enhance, py::arg("V"), py::arg("F"), py::arg("repeats") = 1,
