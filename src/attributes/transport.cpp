@@ -240,18 +240,18 @@ MeshAttributes transport_attributes(const Mesh& input, const std::vector<Index>&
   // Each mover's wedges and where each lands, in parallel (each vertex writes its own slots).
   std::vector<std::vector<std::vector<Index>>> wedges(movers.size());
   std::vector<std::vector<Location>> located(movers.size());
+  const double h = any_interpolated ? mean_edge_length(input.V, topology) : 0;
   if (any_interpolated) {
     // Within a tenth of an edge of the best face so far: the flow's vertices are on the surface
     // (best about 0), so this is the landing point's neighbourhood, not a disk of faces (two
     // edges cost 4x the time for the same answers on the swim tests).
-    const double slack = 0.1 * mean_edge_length(input.V, topology);
+    const double slack = 0.1 * h;
     tbb::enumerable_thread_specific<Walker> walkers([&] { return Walker(input, faces, topology, flag, slack); });
     tbb::parallel_for(std::size_t{0}, movers.size(), [&](std::size_t i) {
       Walker& walker = walkers.local();
       wedges[i] = wedges_of(movers[i], topology, flag);
       for (const auto& wedge : wedges[i]) located[i].push_back(walker.locate(moved.row(movers[i]).transpose(), wedge));
     });
-    const double h = mean_edge_length(input.V, topology);
     for (const auto& locations : located)
       for (const Location& l : locations) {
         ++report.wedges_located;

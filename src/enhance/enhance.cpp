@@ -4,6 +4,7 @@
 
 #include "attributes/transport.h"
 #include "enhance/workable_faces.h"
+#include "mesh/duplicate_faces.h"
 
 #include "vertexflow/enhance_options.h"
 #include "vertexflow/report_json.h"
@@ -463,38 +464,13 @@ namespace enhance_detail {
 
 std::vector<Index> workable_faces(const Mesh& mesh) {
   const auto m = static_cast<std::size_t>(mesh.num_faces());
-  std::vector<char> out(m, 0);
+  // Repeats of an earlier face (the reader's test, mesh/duplicate_faces.h), zero area, or a
+  // repeated vertex.
+  std::vector<char> out = find_duplicate_faces(mesh.F.data(), m, mesh.num_vertices());
   for (const Index f : degenerate_faces(mesh.V, mesh.F)) out[static_cast<std::size_t>(f)] = 1;
-  // Repeats: faces bucketed by their smallest vertex (a counting sort, linear time; a full sort
-  // of the keys was a tenth of the engine's own time on a 10k mesh), then compared within their
-  // bucket; each but the first of equal faces is out.
-  std::vector<std::array<Index, 3>> keys(m);
-  std::vector<Index> start(static_cast<std::size_t>(mesh.num_vertices()) + 1, 0);
-  for (std::size_t f = 0; f < m; ++f) {
-    std::array<Index, 3>& key = keys[f];
-    key = {mesh.F(static_cast<Index>(f), 0), mesh.F(static_cast<Index>(f), 1), mesh.F(static_cast<Index>(f), 2)};
-    std::sort(key.begin(), key.end());
-    if (key[0] == key[1] || key[1] == key[2]) out[f] = 1;
-    ++start[static_cast<std::size_t>(key[0]) + 1];
-  }
-  for (std::size_t v = 1; v < start.size(); ++v) start[v] += start[v - 1];
-  std::vector<Index> order(m);
-  {
-    std::vector<Index> fill(start.begin(), start.end() - 1);
-    for (std::size_t f = 0; f < m; ++f)
-      order[static_cast<std::size_t>(fill[static_cast<std::size_t>(keys[f][0])]++)] = static_cast<Index>(f);
-  }
-  for (std::size_t v = 0; v + 1 < start.size(); ++v) {
-    const auto begin = order.begin() + start[v], end = order.begin() + start[v + 1];
-    if (end - begin < 2) continue;
-    // Faces are in increasing order within a bucket; a stable sort by key keeps the first first.
-    std::stable_sort(begin, end, [&](Index a, Index b) {
-      return keys[static_cast<std::size_t>(a)] < keys[static_cast<std::size_t>(b)];
-    });
-    for (auto it = begin + 1; it != end; ++it)
-      if (keys[static_cast<std::size_t>(*it)] == keys[static_cast<std::size_t>(*(it - 1))])
-        out[static_cast<std::size_t>(*it)] = 1;
-  }
+  for (Index f = 0; f < mesh.num_faces(); ++f)
+    if (mesh.F(f, 0) == mesh.F(f, 1) || mesh.F(f, 1) == mesh.F(f, 2) || mesh.F(f, 2) == mesh.F(f, 0))
+      out[static_cast<std::size_t>(f)] = 1;
   std::vector<Index> faces;
   faces.reserve(m);
   for (std::size_t f = 0; f < m; ++f)
@@ -522,9 +498,6 @@ EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const
   const std::vector<Index> faces = enhance_detail::workable_faces(mesh);
   // Vertices of the faces kept out are held; vertices with no workable face are left out.
   std::vector<Index> to_work(static_cast<std::size_t>(n), -1);
-  std::vector<char> held(static_cast<std::size_t>(n), 0);
-  for (Index f = 0; f < mesh.num_faces(); ++f)
-    for (int k = 0; k < 3; ++k) held[static_cast<std::size_t>(mesh.F(f, k))] = 1;
   for (const Index f : faces)
     for (int k = 0; k < 3; ++k) to_work[static_cast<std::size_t>(mesh.F(f, k))] = 0;
   std::vector<Index> to_input;
@@ -533,10 +506,10 @@ EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const
       to_work[static_cast<std::size_t>(v)] = static_cast<Index>(to_input.size());
       to_input.push_back(v);
     }
+  std::vector<char> held(static_cast<std::size_t>(n), 0);
   {
     std::vector<char> in_workable(static_cast<std::size_t>(mesh.num_faces()), 0);
     for (const Index f : faces) in_workable[static_cast<std::size_t>(f)] = 1;
-    std::fill(held.begin(), held.end(), 0);
     for (Index f = 0; f < mesh.num_faces(); ++f)
       if (!in_workable[static_cast<std::size_t>(f)])
         for (int k = 0; k < 3; ++k) held[static_cast<std::size_t>(mesh.F(f, k))] = 1;
