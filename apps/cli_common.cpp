@@ -4,8 +4,11 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <map>
+#include <set>
+#include <stdexcept>
 #include <system_error>
 
 namespace vertexflow::cli {
@@ -134,6 +137,33 @@ void warn_about_repairs(const std::string& input, const SurfaceRepairs& repairs,
                input, repairs.removed_degenerate_faces, repairs.duplicated_vertices);
 }
 
+namespace {
+// The options add_enhance_options registered: the option table checks their values.
+std::set<const CLI::Option*>& table_checked_options() {
+  static std::set<const CLI::Option*> options;
+  return options;
+}
+}  // namespace
+
+void require_finite_numbers(CLI::App& app) {
+  for (CLI::Option* option : app.get_options()) {
+    if (option->get_type_name().rfind("FLOAT", 0) != 0 || table_checked_options().count(option) > 0) continue;
+    const std::string name = option->get_name();
+    // transform() puts the check first, so a range check never sees a NaN or infinity (nor
+    // prints inf against a range in 309 digits). Thrown as std::invalid_argument (not CLI11's
+    // ValidationError, which CLI11 reports itself) for main()'s one-line error.
+    option->transform(CLI::Validator(
+        [name](std::string& text) {
+          double value = 0;
+          if (CLI::detail::lexical_cast(text, value) && !std::isfinite(value))
+            throw std::invalid_argument(name + ": " + text + " is not a finite number");
+          return std::string();
+        },
+        ""));
+  }
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) require_finite_numbers(*sub);
+}
+
 void add_enhance_options(CLI::App* command, GivenOptions& given, std::initializer_list<std::string_view> skip) {
   static const EnhanceOptions defaults;
   for (const EnhanceOptionSpec& spec : enhance_option_specs()) {
@@ -168,6 +198,7 @@ void add_enhance_options(CLI::App* command, GivenOptions& given, std::initialize
       case OptionKind::Indices:
         continue;  // no flag (--pin FILE reads them)
     }
+    table_checked_options().insert(option);
     const OptionValue fallback = spec.get(defaults);
     if (!std::holds_alternative<std::monostate>(fallback)) {
       std::string text = python_literal(fallback);

@@ -85,6 +85,15 @@ using GivenOptions = std::map<std::string, OptionValue, std::less<>>;
 /// range as it is parsed (std::invalid_argument naming the flag) and stored in `given`.
 void add_enhance_options(CLI::App* command, GivenOptions& given, std::initializer_list<std::string_view> skip = {});
 
+/// Refuses NaN and infinities for every floating-point option of `app` and its subcommands (those
+/// whose CLI11 type is FLOAT, lists included) before any other check of the option runs:
+/// std::invalid_argument "--flag: VALUE is not a finite number", one line and exit 1 in main().
+/// CLI11 parses "nan" and "inf" as numbers, and a NaN passes every range check (each comparison
+/// is false), so without this a NaN angle gives a blank picture with exit 0. Options of
+/// add_enhance_options are left to the option table's own check (in its words). Call it once,
+/// after every command is registered.
+void require_finite_numbers(CLI::App& app);
+
 /// EnhanceOptions with the given values set (the rest at their defaults).
 EnhanceOptions enhance_options_from(const GivenOptions& given);
 

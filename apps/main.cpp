@@ -39,10 +39,15 @@ int main(int argc, char** argv) {
   register_report_command(app, global);
   register_compare_command(app, global);
   register_batch_command(app, global);
+  require_finite_numbers(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    return app.exit(e);
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    // A usage error is one line and exit 1, as every other error (CLI11 would add a hint line
+    // and exit 105-109 by kind).
+    fmt::print(stderr, "vertexflow: error: {}\n", e.what());
+    return 1;
   } catch (const vertexflow::IoError& e) {
     fmt::print(stderr, "vertexflow: error: {}\n", e.what());  // names its file already
     return 1;

@@ -6,7 +6,10 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <fstream>
+#include <regex>
+#include <sstream>
 
 #include <sys/stat.h>
 
@@ -90,10 +93,79 @@ TEST(CliAttributes, EnhanceCarriesThemAndEveryDropIsNamed) {
       << remesh.err;
 }
 
+// Every floating-point option of every subcommand, as their --help lists them (CLI11's FLOAT),
+// refuses nan, inf and -inf before anything is read: one line naming the option, exit 1, nothing
+// written (issue 32 item 3: `render --view custom --azimuth nan` wrote a blank PNG with exit 0,
+// and a NaN passed every range check).
+TEST(Cli, EveryFloatingPointOptionRefusesNanAndInfinity) {
+  test::ScratchDir dir("cli-non-finite");
+  const auto input = dir.file("in.obj");
+  std::ofstream(input) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  const auto lines_of = [](const std::string& text) {
+    std::vector<std::string> lines;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);) lines.push_back(line);
+    return lines;
+  };
+  std::vector<std::string> commands;
+  bool in_subcommands = false;
+  for (const std::string& line : lines_of(run_cli("--help").out)) {
+    if (line == "Subcommands:") in_subcommands = true;
+    std::smatch m;
+    if (in_subcommands && std::regex_match(line, m, std::regex(R"(  ([a-z][a-z-]*)\b.*)"))) commands.push_back(m[1]);
+  }
+  ASSERT_GE(commands.size(), 11u);
+  // "  --frame FLOAT x 6", "    --edge-length FLOAT:POSITIVE", "  --weights FLOAT ..."
+  const std::regex float_option(R"(\s+(?:-\w,)?(--[\w-]+) FLOAT\S*(?: x (\d+))?.*)");
+  int checked = 0;
+  std::vector<std::string> seen;
+  for (const std::string& command : commands) {
+    const std::string extension = command == "render" ? ".png" : command == "lines" ? ".svg" : ".obj";
+    const auto output = dir.file("out-" + command + (command == "batch" ? "" : extension));
+    for (const std::string& line : lines_of(run_cli(command + " --help").out)) {
+      std::smatch m;
+      if (!std::regex_match(line, m, float_option)) continue;
+      const std::string option = m[1];
+      seen.push_back(command + " " + option);
+      const int count = m[2].matched ? std::stoi(m[2]) : 1;
+      for (const std::string bad : {"nan", "inf", "-inf"}) {
+        std::string values = bad;
+        for (int i = 1; i < count; ++i) values += " 1";
+        const std::string arguments =
+            command + " " + test::quoted(input) + " " + test::quoted(output) + " " + option + " " + values;
+        const auto r = run_cli(arguments);
+        ++checked;
+        EXPECT_EQ(r.exit_code, 1) << arguments << "\n" << r.err;
+        EXPECT_EQ(r.err.rfind("vertexflow: error: ", 0), 0u) << arguments << "\n" << r.err;
+        EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << arguments << "\n" << r.err;
+        EXPECT_NE(r.err.find(option + ": " + bad), std::string::npos) << arguments << "\n" << r.err;
+        EXPECT_FALSE(std::filesystem::exists(output)) << arguments;
+      }
+    }
+  }
+  // The help was read: the camera's angles and the enhance table's options are among them.
+  for (const char* expected :
+       {"render --azimuth", "render --elevation", "lines --azimuth", "lines --frame", "compare-lines --elevation",
+        "remesh --edge-length", "enhance --lambda", "batch --lambda"})
+    EXPECT_NE(std::find(seen.begin(), seen.end(), expected), seen.end()) << expected;
+  EXPECT_GT(checked, 100);
+  // An angle in range still draws (the check is for non-finite values only).
+  const auto good = dir.file("good.png");
+  const auto r = run_cli("render " + test::quoted(input) + " " + test::quoted(good) +
+                         " --view custom --azimuth 400 --elevation -90 --size 64x48");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(std::filesystem::exists(good));
+}
+
 TEST(Cli, UsageErrorsFail) {
   EXPECT_NE(run_cli("").exit_code, 0);
   EXPECT_NE(run_cli("info").exit_code, 0);
   EXPECT_NE(run_cli("frobnicate x.off").exit_code, 0);
+  // One line and exit 1, as every error (CLI11 adds a hint line and exits 105-109 by kind).
+  const auto out_of_range = run_cli("render in.obj out.png --elevation 100");
+  EXPECT_EQ(out_of_range.exit_code, 1);
+  EXPECT_EQ(out_of_range.err.rfind("vertexflow: error: --elevation", 0), 0u) << out_of_range.err;
+  EXPECT_EQ(std::count(out_of_range.err.begin(), out_of_range.err.end(), '\n'), 1) << out_of_range.err;
   const auto version = run_cli("--version");
   EXPECT_EQ(version.exit_code, 0);
   EXPECT_NE(version.out.find("vertexflow"), std::string::npos);
