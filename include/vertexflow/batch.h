@@ -90,7 +90,9 @@ struct BatchItem {
 
 struct BatchOptions {
   /// Directories (every regular, non-hidden file in it with a mesh extension, sorted by name),
-  /// glob patterns (glob(3), sorted) or files. Ignored when `items` is not empty.
+  /// glob patterns (glob(3), sorted; its matches with a mesh extension that are not directories)
+  /// or files. So a batch's own batch_summary.csv and .json are never inputs. Ignored when
+  /// `items` is not empty.
   std::vector<std::string> inputs;
   /// The files as rows (read_batch_manifest), instead of `inputs`.
   std::vector<BatchItem> items;
@@ -118,7 +120,7 @@ struct BatchSummary {
 };
 
 /// The input list of a batch, in order (see BatchOptions::inputs). Throws IoError for a pattern
-/// that matches nothing or a path that does not exist.
+/// that matches no mesh file name or a path that does not exist.
 std::vector<std::filesystem::path> batch_inputs(const std::vector<std::string>& inputs);
 
 /// Reads a manifest: CSV with a header row naming the columns input, reference and output

@@ -311,14 +311,24 @@ std::vector<BatchItem> read_batch_manifest(const std::filesystem::path& manifest
   return items;
 }
 
+namespace {
+
+// Whether a glob match is an input, as a directory's entries are: a mesh file name (a directory
+// also holds summaries, reports and notes, and when it was a batch's output directory too, that
+// batch's batch_summary.csv and .json), and not a directory.
+bool is_listed_input(const std::filesystem::path& path) {
+  std::error_code ec;
+  return is_mesh_path(path) && !std::filesystem::is_directory(path, ec);
+}
+
+}  // namespace
+
 std::vector<std::filesystem::path> batch_inputs(const std::vector<std::string>& inputs) {
   std::vector<std::filesystem::path> files;
   for (const std::string& spec : inputs) {
     std::error_code ec;
     if (std::filesystem::is_directory(spec, ec)) {
       std::vector<std::filesystem::path> in_dir;
-      // Mesh files only: a directory also holds summaries, reports and notes (and, when it is
-      // a batch's output directory too, batch_summary.csv and .json).
       for (const auto& entry : std::filesystem::directory_iterator(spec, ec)) {
         const std::string name = entry.path().filename().string();
         if (!name.empty() && name[0] != '.' && entry.is_regular_file(ec) && is_mesh_path(entry.path()))
@@ -332,9 +342,9 @@ std::vector<std::filesystem::path> batch_inputs(const std::vector<std::string>& 
       const int status = ::glob(spec.c_str(), 0, nullptr, &g);
       std::vector<std::filesystem::path> matched;
       for (std::size_t i = 0; status == 0 && i < g.gl_pathc; ++i)
-        if (!std::filesystem::is_directory(g.gl_pathv[i], ec)) matched.emplace_back(g.gl_pathv[i]);
+        if (is_listed_input(g.gl_pathv[i])) matched.emplace_back(g.gl_pathv[i]);
       ::globfree(&g);
-      if (matched.empty()) throw IoError(spec + ": matches no file");
+      if (matched.empty()) throw IoError(spec + ": matches no mesh file");
       files.insert(files.end(), matched.begin(), matched.end());
     } else {
       if (!std::filesystem::exists(spec, ec)) throw IoError(spec + ": no such file or directory");

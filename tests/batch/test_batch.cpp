@@ -1,6 +1,7 @@
 // The batch engine (batch.h) and `vertexflow batch`: every mode, references from a manifest or a
 // directory, outputs bit for bit those of `vertexflow enhance`, summaries with each file's mode
-// and distances, and a directory's own summaries never taken for inputs.
+// and distances, a directory's own summaries never taken for inputs, a damaged summary named and
+// its rows measured again, hostile directory entries failing alike in directory and glob mode.
 #include "shapes.h"
 #include "test_support.h"
 
@@ -10,8 +11,13 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <sys/stat.h>
+
+#include <algorithm>
 #include <fstream>
+#include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace vertexflow {
 namespace {
@@ -181,6 +187,45 @@ TEST(Batch, ManifestProblemsNameTheFileAndLine) {
   EXPECT_TRUE(items[1].reference.empty());
   write_text(json, R"({"input": "a.off"})");
   EXPECT_THROW((void)read_batch_manifest(json), IoError);
+}
+
+// A directory of three small meshes with features for the flow to move.
+std::filesystem::path three_meshes(const test::ScratchDir& dir) {
+  const auto in = dir.file("in");
+  std::filesystem::create_directories(in);
+  write_mesh(in / "cube.off", test::rounded_cube(1.0, 0.2, 3));
+  write_mesh(in / "sphere.obj", test::icosphere(1.0, 2));
+  write_mesh(in / "torus.ply", test::torus(1.0, 0.3, 24, 10));
+  return in;
+}
+
+nlohmann::json summary_rows(const std::filesystem::path& out) {
+  return nlohmann::json::parse(test::read_text(out / "batch_summary.json"))["files"];
+}
+
+// Issue 32 item 5: after `vertexflow batch DIR DIR` (every file fails: its output would be its
+// input), DIR holds that batch's summaries; `batch DIR OUT2` and `batch 'DIR/*' OUT3` take the
+// mesh files only.
+TEST(Batch, ItsOwnSummariesAreNeverInputs) {
+  test::ScratchDir dir("batch-own-summaries");
+  const auto in = three_meshes(dir);
+  write_text(in / "notes.txt", "not a mesh\n");
+  const auto into_itself = test::run_cli("--quiet batch " + test::quoted(in) + " " + test::quoted(in));
+  EXPECT_EQ(into_itself.exit_code, 1);
+  ASSERT_TRUE(std::filesystem::exists(in / "batch_summary.csv"));
+  ASSERT_TRUE(std::filesystem::exists(in / "batch_summary.json"));
+  for (const std::string& spec : {in.string(), (in / "*").string()}) {
+    const auto out = dir.file(spec == in.string() ? "out2" : "out3");
+    const auto r = test::run_cli("batch " + test::shell_quote(spec) + " " + test::quoted(out));
+    EXPECT_EQ(r.exit_code, 0) << spec << ": " << r.err;
+    std::vector<std::string> inputs;
+    for (const auto& row : summary_rows(out)) {
+      inputs.push_back(std::filesystem::path(row["input"].get<std::string>()).filename().string());
+      EXPECT_EQ(row["status"], "done") << row.dump();
+    }
+    EXPECT_EQ(inputs, (std::vector<std::string>{"cube.off", "sphere.obj", "torus.ply"})) << spec;
+  }
+  EXPECT_THROW((void)batch_inputs({(in / "*.csv").string()}), IoError);  // matches no mesh file
 }
 
 }  // namespace
