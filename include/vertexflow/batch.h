@@ -89,9 +89,10 @@ struct BatchItem {
 };
 
 struct BatchOptions {
-  /// Directories (every regular, non-hidden file in it with a mesh extension, sorted by name),
-  /// glob patterns (glob(3), sorted; its matches with a mesh extension that are not directories)
-  /// or files. So a batch's own batch_summary.csv and .json are never inputs. Ignored when
+  /// Directories (every non-hidden entry with a mesh extension that is not a directory, sorted
+  /// by name), glob patterns (glob(3), sorted; its matches with a mesh extension that are not
+  /// directories) or files. So a batch's own batch_summary.csv and .json are never inputs, and a
+  /// dangling link, a FIFO or a device named *.obj is a failed row in both modes. Ignored when
   /// `items` is not empty.
   std::vector<std::string> inputs;
   /// The files as rows (read_batch_manifest), instead of `inputs`.

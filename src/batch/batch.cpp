@@ -313,9 +313,11 @@ std::vector<BatchItem> read_batch_manifest(const std::filesystem::path& manifest
 
 namespace {
 
-// Whether a glob match is an input, as a directory's entries are: a mesh file name (a directory
-// also holds summaries, reports and notes, and when it was a batch's output directory too, that
-// batch's batch_summary.csv and .json), and not a directory.
+// Whether a directory entry or a glob match is an input, the same test in both modes: a mesh file
+// name (a directory also holds summaries, reports and notes, and when it was a batch's output
+// directory too, that batch's batch_summary.csv and .json), and not a directory. Any other kind
+// of file is an input, not left out silently: a dangling link, a FIFO or a device fails as its
+// row with read_mesh's reason (which opens without blocking and takes regular files only).
 bool is_listed_input(const std::filesystem::path& path) {
   std::error_code ec;
   return is_mesh_path(path) && !std::filesystem::is_directory(path, ec);
@@ -331,8 +333,7 @@ std::vector<std::filesystem::path> batch_inputs(const std::vector<std::string>& 
       std::vector<std::filesystem::path> in_dir;
       for (const auto& entry : std::filesystem::directory_iterator(spec, ec)) {
         const std::string name = entry.path().filename().string();
-        if (!name.empty() && name[0] != '.' && entry.is_regular_file(ec) && is_mesh_path(entry.path()))
-          in_dir.push_back(entry.path());
+        if (!name.empty() && name[0] != '.' && is_listed_input(entry.path())) in_dir.push_back(entry.path());
       }
       if (ec) throw IoError(spec + ": cannot list the directory: " + ec.message());
       std::sort(in_dir.begin(), in_dir.end());

@@ -228,5 +228,41 @@ TEST(Batch, ItsOwnSummariesAreNeverInputs) {
   EXPECT_THROW((void)batch_inputs({(in / "*.csv").string()}), IoError);  // matches no mesh file
 }
 
+// Issue 32 item 6: a dangling *.obj link, a FIFO named *.obj and a link to /dev/zero are failed
+// rows naming the file in directory mode as in glob mode (directory mode left them out with exit
+// 0), and neither blocks on the FIFO. A directory named *.obj and a text file are no inputs in
+// either.
+TEST(Batch, HostileEntriesAreFailedRowsInDirectoryAndGlobModeAlike) {
+  test::ScratchDir dir("batch-hostile");
+  const auto in = dir.file("in");
+  std::filesystem::create_directories(in / "folder.obj");
+  write_mesh(in / "good.obj", test::icosphere(1.0, 1));
+  std::filesystem::create_symlink(in / "missing.off", in / "dangling.obj");
+  ASSERT_EQ(::mkfifo((in / "pipe.obj").c_str(), 0600), 0);
+  std::filesystem::create_symlink("/dev/zero", in / "zero.obj");
+  write_text(in / "notes.txt", "not a mesh\n");
+  std::vector<nlohmann::json> rows;
+  for (const std::string& spec : {in.string(), (in / "*").string(), (in / "*.obj").string()}) {
+    const auto out = dir.file("out" + std::to_string(rows.size()));
+    const auto r = test::run_cli_watched({"--quiet", "batch", spec, out.string()}, 120);
+    ASSERT_FALSE(r.timed_out) << spec;
+    EXPECT_EQ(r.exit_code, 1) << spec << ": " << r.err;
+    EXPECT_NE(r.err.find("3 of 4 files failed"), std::string::npos) << spec << ": " << r.err;
+    nlohmann::json listed = nlohmann::json::array();
+    for (const auto& row : summary_rows(out))
+      listed.push_back(
+          {std::filesystem::path(row["input"].get<std::string>()).filename().string(), row["status"], row["error"]});
+    rows.push_back(listed);
+  }
+  const nlohmann::json expected = {
+      {"dangling.obj", "failed", (in / "dangling.obj").string() + ": cannot open: No such file or directory"},
+      {"good.obj", "done", nullptr},
+      {"pipe.obj", "failed", (in / "pipe.obj").string() + ": is not a regular file"},
+      {"zero.obj", "failed", (in / "zero.obj").string() + ": is not a regular file"}};
+  EXPECT_EQ(rows[0], expected) << rows[0].dump(1);
+  EXPECT_EQ(rows[1], expected) << rows[1].dump(1);
+  EXPECT_EQ(rows[2], expected) << rows[2].dump(1);
+}
+
 }  // namespace
 }  // namespace vertexflow
