@@ -83,6 +83,7 @@ void register_batch_command(CLI::App& app, const GlobalOptions& global) {
     o->batch.file.metrics = !o->no_metrics;
     const bool tty = ::isatty(STDERR_FILENO) == 1;
     if (!global.quiet) {
+      o->batch.warning = [](const std::string& warning) { fmt::print(stderr, "vertexflow: warning: {}\n", warning); };
       o->batch.progress = [tty](const BatchProgress& p) {
         const BatchRow& row = *p.row;
         const std::string eta = p.eta >= 0 ? clock_text(p.eta) : std::string("?");

@@ -32,7 +32,11 @@ struct BatchRow {
   std::string mode;       ///< enhance_mode_name of the file's mode ("flow", "reference", ...)
   /// "done", "skipped" (output existed) or "failed". A skipped file keeps the measurements and
   /// seconds of the run that wrote its output, from the batch_summary.json found in the output
-  /// directory (none if there is none), so a resumed batch's summary still has every file.
+  /// directory. Where that summary has no complete row for it (none, a damaged one, or a row
+  /// without metrics when metrics are on), its metrics are measured again from its input and the
+  /// output on disk; the seconds are then this run's and limited_vertices (which only the run
+  /// that wrote the output knew) stays -1. So a resumed batch's summary has every output's
+  /// numbers.
   std::string status;
   std::string error;     ///< the one-line error of a failed file ("FILE: problem")
   std::string warnings;  ///< reading and enhance warnings, "; "-separated
@@ -107,6 +111,9 @@ struct BatchOptions {
   BatchFileOptions file;
   /// Called after every file from the thread that finished it, one call at a time.
   std::function<void(const BatchProgress&)> progress;
+  /// Called with each warning about the batch as a whole, one line naming its file (an earlier
+  /// batch_summary.json that cannot be read), from the calling thread before any file runs.
+  std::function<void(const std::string&)> warning;
   /// Write batch_summary.csv and batch_summary.json into output_dir.
   bool write_summary = true;
   /// How the options' errors name an option (the front end's words, enhance.h).

@@ -8,6 +8,8 @@
 #include <pybind11/stl/filesystem.h>
 
 #include <optional>
+#include <string>
+#include <vector>
 
 namespace vertexflow::python {
 namespace {
@@ -69,6 +71,10 @@ py::dict py_batch(const py::object& inputs, const py::object& output_dir, const 
   // run_batch checks the mode's rules, in the keywords' names, before any file is read.
   options.naming = OptionNaming::Python;
   options.file = file_options(given, std::nullopt, force, metrics, threads, "batch");
+  // Warnings about the batch as a whole (an unreadable earlier summary), raised as UserWarnings
+  // once the GIL is held again.
+  std::vector<std::string> warnings;
+  options.warning = [&warnings](const std::string& warning) { warnings.push_back(warning); };
   if (!progress.is_none()) {
     options.progress = [progress](const BatchProgress& p) {
       py::gil_scoped_acquire acquire;
@@ -94,6 +100,8 @@ py::dict py_batch(const py::object& inputs, const py::object& output_dir, const 
     py::gil_scoped_release release;
     summary = run_batch(options);
   }
+  for (const std::string& warning : warnings)
+    if (PyErr_WarnEx(PyExc_UserWarning, warning.c_str(), 1) != 0) throw py::error_already_set();
   py::dict d;
   py::list rows;
   for (const auto& row : summary.rows) rows.append(to_python(to_json(row)));

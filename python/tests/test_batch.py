@@ -172,3 +172,32 @@ def test_batch_over_a_manifest_of_pairs_writes_what_enhance_reference_writes(lod
     for coarse, _ in lod_pairs:
         assert sha256(tmp_path / "cli" / coarse.name) == lod_cli[coarse.name], coarse.name
         assert sha256(tmp_path / "by_stem" / coarse.name) == lod_cli[coarse.name], coarse.name
+
+
+def bumpy_grids(directory, count):
+    """count small bumpy height fields, each with its own bump: files for a batch to work on."""
+    directory.mkdir()
+    n = 9
+    x, y = np.meshgrid(np.linspace(-1, 1, n), np.linspace(-1, 1, n))
+    cells = [(i * n + j, i * n + j + 1, (i + 1) * n + j, (i + 1) * n + j + 1) for i in range(n - 1) for j in range(n - 1)]
+    F = np.array([f for a, b, c, d in cells for f in ((a, b, d), (a, d, c))], dtype=np.int64)
+    for k in range(count):
+        z = 0.3 * np.exp(-((x - 0.1 * k) ** 2 + y**2) * 4)
+        vertexflow.write_mesh(directory / f"grid{k}.obj", np.column_stack([x.ravel(), y.ravel(), z.ravel()]), F)
+    return directory
+
+
+def test_a_damaged_summary_is_a_warning_and_its_rows_are_measured_again(tmp_path):
+    # Issue 32 item 4, through Python: one UserWarning naming the summary, every row measured.
+    inputs = bumpy_grids(tmp_path / "in", 2)
+    out = tmp_path / "out"
+    first = vertexflow.batch(inputs, out, threads=1)
+    text = (out / "batch_summary.json").read_text()
+    (out / "batch_summary.json").write_text(text[: len(text) // 3])
+    with pytest.warns(UserWarning, match="batch_summary.json: cannot read the earlier summary"):
+        again = vertexflow.batch(inputs, out, threads=1)
+    for old, new in zip(first["files"], again["files"]):
+        assert new["status"] == "skipped"
+        assert new["redistribution_rho"]["result"] == pytest.approx(old["redistribution_rho"]["result"], rel=1e-12)
+        assert new["displacement_edge_lengths"]["max"] == pytest.approx(
+            old["displacement_edge_lengths"]["max"], rel=1e-12)

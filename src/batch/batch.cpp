@@ -47,18 +47,41 @@ Mesh read_with_warnings(const std::filesystem::path& path, std::vector<std::stri
   return mesh;
 }
 
+// The metrics of enhance_metrics (`m`) into `row`.
+void take_metrics(const nlohmann::json& m, BatchRow& row) {
+  row.flipped_faces = m["flipped_faces"].get<long long>();
+  row.rho_input = m["redistribution_rho"]["input"].get<double>();
+  row.rho_result = m["redistribution_rho"]["result"].get<double>();
+  row.cv_input = m["edge_error_cv"]["input"].get<double>();
+  row.cv_result = m["edge_error_cv"]["result"].get<double>();
+  row.displacement_mean = m["displacement_edge_lengths"]["mean"].get<double>();
+  row.displacement_max = m["displacement_edge_lengths"]["max"].get<double>();
+  if (m.contains("distance_to_reference")) {
+    const auto& d = m["distance_to_reference"];
+    row.distance_mean_input = d["input"]["mean"].get<double>();
+    row.distance_mean_result = d["result"]["mean"].get<double>();
+    row.hausdorff_input = d["input"]["hausdorff"].get<double>();
+    row.hausdorff_result = d["result"]["hausdorff"].get<double>();
+  }
+}
+
+// The reference surface of a file (none for an empty path), its reading warnings named.
+std::optional<ReferenceSurface> read_reference(const std::filesystem::path& path, std::vector<std::string>& warnings) {
+  std::optional<ReferenceSurface> reference;
+  if (path.empty()) return reference;
+  std::vector<std::string> reference_warnings;
+  Mesh dense = read_with_warnings(path, reference_warnings, false);
+  for (const std::string& w : reference_warnings) warnings.push_back(path.string() + ": " + w);
+  reference.emplace(std::move(dense.V), std::move(dense.F), path.string());
+  return reference;
+}
+
 void run_file(const std::filesystem::path& input, const std::filesystem::path& output,
               const std::filesystem::path& reference_path, const BatchFileOptions& options, BatchRow& row) {
   auto start = Clock::now();
   std::vector<std::string> warnings;
   const Mesh mesh = read_with_warnings(input, warnings, true);
-  std::optional<ReferenceSurface> reference;
-  if (!reference_path.empty()) {
-    std::vector<std::string> reference_warnings;
-    Mesh dense = read_with_warnings(reference_path, reference_warnings, false);
-    for (const std::string& w : reference_warnings) warnings.push_back(reference_path.string() + ": " + w);
-    reference.emplace(std::move(dense.V), std::move(dense.F), reference_path.string());
-  }
+  const std::optional<ReferenceSurface> reference = read_reference(reference_path, warnings);
   row.seconds_read = seconds_since(start);
   row.vertices = mesh.num_vertices();
   row.faces = mesh.num_faces();
@@ -93,21 +116,7 @@ void run_file(const std::filesystem::path& input, const std::filesystem::path& o
 
   if (options.metrics) {
     start = Clock::now();
-    const nlohmann::json m = enhance_metrics(mesh, result.mesh, reference_pointer);
-    row.flipped_faces = m["flipped_faces"].get<long long>();
-    row.rho_input = m["redistribution_rho"]["input"].get<double>();
-    row.rho_result = m["redistribution_rho"]["result"].get<double>();
-    row.cv_input = m["edge_error_cv"]["input"].get<double>();
-    row.cv_result = m["edge_error_cv"]["result"].get<double>();
-    row.displacement_mean = m["displacement_edge_lengths"]["mean"].get<double>();
-    row.displacement_max = m["displacement_edge_lengths"]["max"].get<double>();
-    if (m.contains("distance_to_reference")) {
-      const auto& d = m["distance_to_reference"];
-      row.distance_mean_input = d["input"]["mean"].get<double>();
-      row.distance_mean_result = d["result"]["mean"].get<double>();
-      row.hausdorff_input = d["input"]["hausdorff"].get<double>();
-      row.hausdorff_result = d["result"]["hausdorff"].get<double>();
-    }
+    take_metrics(enhance_metrics(mesh, result.mesh, reference_pointer), row);
     row.seconds_metrics = seconds_since(start);
   }
 }
@@ -120,25 +129,41 @@ std::string csv_field(const std::string& s) {
 }
 
 // The rows of an earlier summary in the output directory, by input path: a file skipped now keeps
-// the measurements of the run that wrote its output. A missing or unreadable summary gives none.
-std::map<std::string, nlohmann::json> previous_rows(const std::filesystem::path& json_path) {
+// the measurements of the run that wrote its output. A missing summary gives none; an unreadable
+// one (a run killed while writing it, a truncated copy) gives none and its `problem`, which the
+// batch reports, since its skipped files are then measured again (take_measurements).
+struct PreviousRows {
   std::map<std::string, nlohmann::json> rows;
+  std::string problem;
+};
+
+PreviousRows previous_rows(const std::filesystem::path& json_path) {
+  PreviousRows previous;
   std::error_code ec;
-  if (!std::filesystem::is_regular_file(json_path, ec)) return rows;
+  if (!std::filesystem::exists(json_path, ec)) return previous;
   try {
+    if (!std::filesystem::is_regular_file(json_path, ec)) throw IoError("not a regular file");
     std::ifstream in(json_path);
     const nlohmann::json summary = nlohmann::json::parse(in);
     for (const auto& row : summary.at("files"))
       if (row.at("status") == "done" || (row.at("status") == "skipped" && !row.at("vertices").is_null()))
-        rows[row.at("input").get<std::string>()] = row;
-  } catch (const std::exception&) {
-    rows.clear();  // not ours, or damaged: start afresh
+        previous.rows[row.at("input").get<std::string>()] = row;
+  } catch (const nlohmann::json::parse_error& e) {
+    previous.rows.clear();
+    previous.problem = fmt::format("not valid JSON (truncated or damaged at byte {})", e.byte);
+  } catch (const std::exception& e) {
+    previous.rows.clear();
+    previous.problem = std::string("not a batch summary (") + e.what() + ")";
   }
-  return rows;
+  if (!previous.problem.empty())
+    previous.problem = json_path.string() + ": cannot read the earlier summary: " + previous.problem +
+                       "; the metrics of the files skipped are measured again from their inputs and outputs";
+  return previous;
 }
 
-// `row` (skipped) with the measurements of `previous` (to_json's layout).
-void take_measurements(BatchRow& row, const nlohmann::json& previous) {
+// `row` (skipped) with the measurements of `previous` (to_json's layout). False, and `row` left
+// as it was, when `previous` is incomplete or is another output's row.
+bool take_measurements(BatchRow& row, const nlohmann::json& previous) {
   const auto number = [](const nlohmann::json& j) { return j.is_number() ? j.get<double>() : std::nan(""); };
   const auto count = [](const nlohmann::json& j) { return j.is_number() ? j.get<long long>() : -1LL; };
   try {
@@ -167,11 +192,52 @@ void take_measurements(BatchRow& row, const nlohmann::json& previous) {
       row.hausdorff_input = number(d.at("hausdorff").at("input"));
       row.hausdorff_result = number(d.at("hausdorff").at("result"));
     }
+    if (previous.at("output").get<std::string>() != row.output) throw std::invalid_argument("another output");
   } catch (const std::exception&) {
-    const BatchRow fresh;
-    row.vertices = fresh.vertices;  // an incomplete row: keep none of it
-    row.faces = fresh.faces;
+    BatchRow fresh;  // an incomplete row: keep none of it
+    fresh.input = row.input;
+    fresh.output = row.output;
+    fresh.reference = row.reference;
+    fresh.status = row.status;
+    fresh.seconds_total = row.seconds_total;
+    row = fresh;
+    return false;
   }
+  return true;
+}
+
+// A skipped file without an earlier row to keep: its metrics measured from its input and the
+// output on disk (what the run that wrote it measured, as the output is that run's mesh), so the
+// summary has numbers for every output. The guard's limited_vertices, known only to that run,
+// stay -1. An output that cannot be measured (not this input's vertices) keeps the row without
+// metrics and says why in its warnings.
+void measure_output(const BatchItem& item, const BatchFileOptions& options, const std::string& mode, BatchRow& row) {
+  const auto start = Clock::now();
+  std::vector<std::string> warnings;
+  const auto measure = [&] {
+    const Mesh input = read_with_warnings(item.input, warnings, true);
+    std::vector<std::string> output_warnings;
+    const Mesh output = read_with_warnings(item.output, output_warnings, true);
+    for (const std::string& w : output_warnings) warnings.push_back(item.output.string() + ": " + w);
+    const std::optional<ReferenceSurface> reference = read_reference(item.reference, warnings);
+    row.seconds_read = seconds_since(start);
+    row.vertices = input.num_vertices();
+    row.faces = input.num_faces();
+    const auto metrics_start = Clock::now();
+    take_metrics(enhance_metrics(input, output, reference ? &*reference : nullptr), row);
+    row.seconds_metrics = seconds_since(metrics_start);
+    row.mode = mode;
+  };
+  try {
+    if (options.threads > 0)
+      tbb::task_arena(options.threads).execute(measure);
+    else
+      measure();
+  } catch (const std::exception& e) {
+    warnings.push_back("the existing output was not measured: " + error_line(item.output, e.what()));
+  }
+  row.warnings = join(warnings);
+  row.seconds_total += seconds_since(start);
 }
 
 std::string csv_number(double x) {
@@ -442,9 +508,10 @@ BatchSummary run_batch(const BatchOptions& options) {
     }
   }
 
-  const std::map<std::string, nlohmann::json> previous = options.write_summary
-                                                             ? previous_rows(options.output_dir / "batch_summary.json")
-                                                             : std::map<std::string, nlohmann::json>{};
+  const PreviousRows previous =
+      options.write_summary ? previous_rows(options.output_dir / "batch_summary.json") : PreviousRows{};
+  if (!previous.problem.empty() && options.warning) options.warning(previous.problem);
+  const std::string mode_name = enhance_mode_name(enhance_mode(options.file.enhance, reference_mode));
   const auto start = Clock::now();
   std::atomic<std::size_t> next{0};
   std::mutex mutex;
@@ -455,8 +522,10 @@ BatchSummary run_batch(const BatchOptions& options) {
       if (!preset[i]) summary.rows[i] = enhance_file(items[i].input, items[i].output, file_options, items[i].reference);
       BatchRow& row = summary.rows[i];
       if (row.status == "skipped") {
-        const auto it = previous.find(row.input);
-        if (it != previous.end()) take_measurements(row, it->second);
+        const auto it = previous.rows.find(row.input);
+        const bool kept = it != previous.rows.end() && take_measurements(row, it->second) &&
+                          (!file_options.metrics || !std::isnan(row.rho_result));
+        if (!kept && file_options.metrics) measure_output(items[i], file_options, mode_name, row);
       }
       const std::lock_guard lock(mutex);
       ++finished;
@@ -501,8 +570,7 @@ BatchSummary run_batch(const BatchOptions& options) {
     j["seconds"] = summary.seconds;
     j["jobs"] = options.jobs;
     j["threads_per_job"] = file_options.threads;
-    const EnhanceMode mode = enhance_mode(options.file.enhance, reference_mode);
-    j["mode"] = enhance_mode_name(mode);
+    j["mode"] = mode_name;
     j["options"] = enhance_options_json(options.file.enhance);
     j["files"] = nlohmann::json::array();
     for (const BatchRow& row : summary.rows) j["files"].push_back(to_json(row));

@@ -203,6 +203,76 @@ nlohmann::json summary_rows(const std::filesystem::path& out) {
   return nlohmann::json::parse(test::read_text(out / "batch_summary.json"))["files"];
 }
 
+// The measurements of a row (to_json's layout): what a resumed run must keep.
+std::vector<nlohmann::json> measurements(const nlohmann::json& row) {
+  return {row["vertices"],           row["faces"],         row["flipped_faces"],
+          row["redistribution_rho"], row["edge_error_cv"], row["displacement_edge_lengths"]};
+}
+
+// Issue 32 item 4: a rerun keeps every earlier row bit for bit; after the summary is truncated, the
+// rerun names it in a warning and measures the skipped files again from their outputs and inputs
+// (it gave them nulls, silently); without a summary at all they are measured too.
+TEST(Batch, ADamagedSummaryIsNamedAndItsRowsMeasuredAgain) {
+  test::ScratchDir dir("batch-damaged-summary");
+  const auto in = three_meshes(dir);
+  const auto out = dir.file("out");
+  const std::string command = "batch " + test::quoted(in) + " " + test::quoted(out);
+  ASSERT_EQ(test::run_cli("--quiet " + command).exit_code, 0);
+  const nlohmann::json first = summary_rows(out);
+  ASSERT_EQ(first.size(), 3u);
+  for (const auto& row : first) {
+    ASSERT_EQ(row["status"], "done") << row.dump();
+    ASSERT_TRUE(row["redistribution_rho"]["result"].is_number()) << row.dump();
+  }
+  EXPECT_GT(first[0]["displacement_edge_lengths"]["max"].get<double>(), 0.0);
+
+  ASSERT_EQ(test::run_cli("--quiet " + command).exit_code, 0);
+  const nlohmann::json kept = summary_rows(out);
+  for (std::size_t i = 0; i < 3; ++i) {
+    EXPECT_EQ(kept[i]["status"], "skipped");
+    EXPECT_EQ(measurements(kept[i]), measurements(first[i])) << kept[i].dump();  // bit for bit
+    EXPECT_EQ(kept[i]["seconds"], first[i]["seconds"]);
+  }
+
+  const std::string text = test::read_text(out / "batch_summary.json");
+  write_text(out / "batch_summary.json", text.substr(0, text.size() / 2));
+  const auto r = test::run_cli(command);
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("vertexflow: warning: " + (out / "batch_summary.json").string() +
+                       ": cannot read the earlier summary: not valid JSON"),
+            std::string::npos)
+      << r.err;
+  const auto expect_measured_again = [&](const nlohmann::json& rows) {
+    ASSERT_EQ(rows.size(), 3u);
+    for (std::size_t i = 0; i < 3; ++i) {
+      const auto& row = rows[i];
+      EXPECT_EQ(row["status"], "skipped");
+      EXPECT_EQ(row["mode"], "flow");
+      EXPECT_EQ(row["vertices"], first[i]["vertices"]);
+      EXPECT_EQ(row["flipped_faces"], first[i]["flipped_faces"]);
+      for (const char* metric : {"redistribution_rho", "edge_error_cv"})
+        for (const char* which : {"input", "result"})
+          EXPECT_DOUBLE_EQ(row[metric][which].get<double>(), first[i][metric][which].get<double>())
+              << metric << " " << which << " " << row.dump();
+      for (const char* which : {"mean", "max"})
+        EXPECT_DOUBLE_EQ(row["displacement_edge_lengths"][which].get<double>(),
+                         first[i]["displacement_edge_lengths"][which].get<double>())
+            << which << " " << row.dump();
+    }
+  };
+  expect_measured_again(summary_rows(out));
+  // The measured rows are kept by the next run as any other.
+  const nlohmann::json measured = summary_rows(out);
+  ASSERT_EQ(test::run_cli("--quiet " + command).exit_code, 0);
+  for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(measurements(summary_rows(out)[i]), measurements(measured[i]));
+
+  std::filesystem::remove(out / "batch_summary.json");
+  const auto none = test::run_cli(command);
+  EXPECT_EQ(none.exit_code, 0) << none.err;
+  EXPECT_EQ(none.err.find("warning"), std::string::npos) << none.err;  // nothing to read is no problem
+  expect_measured_again(summary_rows(out));
+}
+
 // Issue 32 item 5: after `vertexflow batch DIR DIR` (every file fails: its output would be its
 // input), DIR holds that batch's summaries; `batch DIR OUT2` and `batch 'DIR/*' OUT3` take the
 // mesh files only.
