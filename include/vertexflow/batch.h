@@ -109,7 +109,10 @@ struct BatchOptions {
   /// divided among the jobs).
   int jobs = 1;
   BatchFileOptions file;
-  /// Called after every file from the thread that finished it, one call at a time.
+  /// Called after every file from the thread that finished it, one call at a time. An exception
+  /// it throws stops the batch at the next file boundary (the files being processed finish, no
+  /// other starts, progress is not called again), the summary is written with the files finished
+  /// (so a rerun resumes), and run_batch rethrows it: how a front end cancels a batch.
   std::function<void(const BatchProgress&)> progress;
   /// Called with each warning about the batch as a whole, one line naming its file (an earlier
   /// batch_summary.json that cannot be read), from the calling thread before any file runs.

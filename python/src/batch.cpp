@@ -7,6 +7,7 @@
 
 #include <pybind11/stl/filesystem.h>
 
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -75,10 +76,16 @@ py::dict py_batch(const py::object& inputs, const py::object& output_dir, const 
   // once the GIL is held again.
   std::vector<std::string> warnings;
   options.warning = [&warnings](const std::string& warning) { warnings.push_back(warning); };
-  if (!progress.is_none()) {
-    options.progress = [progress](const BatchProgress& p) {
-      py::gil_scoped_acquire acquire;
-      try {
+  // What the progress callback raised (KeyboardInterrupt included), or a signal (Ctrl-C) found
+  // pending after a file: run_batch stops at the next file boundary, keeps what was written and
+  // rethrows Stop, and the Python exception is raised again here.
+  struct Stop {};
+  auto raised = std::make_shared<std::optional<py::error_already_set>>();
+  options.progress = [progress, raised](const BatchProgress& p) {
+    py::gil_scoped_acquire acquire;
+    try {
+      if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+      if (!progress.is_none()) {
         py::dict d;
         d["finished"] = p.finished;
         d["total"] = p.total;
@@ -89,16 +96,18 @@ py::dict py_batch(const py::object& inputs, const py::object& output_dir, const 
         d["elapsed"] = p.elapsed;
         d["eta"] = p.eta >= 0 ? py::object(py::float_(p.eta)) : py::object(py::none());
         progress(d);
-      } catch (py::error_already_set& e) {
-        // An exception in the callback must not stop the batch (or cross a worker thread).
-        e.discard_as_unraisable("vertexflow.batch progress callback");
       }
-    };
-  }
+    } catch (py::error_already_set& e) {
+      *raised = std::move(e);
+      throw Stop{};
+    }
+  };
   BatchSummary summary;
-  {
+  try {
     py::gil_scoped_release release;
     summary = run_batch(options);
+  } catch (const Stop&) {
+    throw std::move(**raised);
   }
   for (const std::string& warning : warnings)
     if (PyErr_WarnEx(PyExc_UserWarning, warning.c_str(), 1) != 0) throw py::error_already_set();

@@ -187,6 +187,42 @@ def bumpy_grids(directory, count):
     return directory
 
 
+@pytest.mark.parametrize("exception", [KeyboardInterrupt, ValueError])
+def test_an_exception_in_the_progress_callback_stops_the_batch_and_is_raised(tmp_path, exception):
+    # Issue 32 item 7: the exception was printed as "Exception ignored" once per file and the batch ran on.
+    inputs = bumpy_grids(tmp_path / "in", 4)
+    out = tmp_path / "out"
+    calls = []
+
+    def progress(p):
+        calls.append(p)
+        raise exception("stop here")
+
+    with pytest.raises(exception, match="stop here"):
+        vertexflow.batch(inputs, out, jobs=1, threads=1, progress=progress)
+    assert len(calls) == 1  # not called again after it raised
+    written = sorted(p.name for p in out.iterdir() if not p.name.startswith("batch_summary"))
+    assert written == ["grid0.obj"]  # stopped at the next file boundary, what was written kept
+    summary = json.loads((out / "batch_summary.json").read_text())
+    assert [r["status"] for r in summary["files"]] == ["done"] and "stopped" in summary
+    resumed = vertexflow.batch(inputs, out, jobs=1, threads=1)
+    assert resumed["skipped"] == 1 and resumed["done"] == 3
+    assert resumed["files"][0]["redistribution_rho"] == summary["files"][0]["redistribution_rho"]
+
+
+def test_an_interrupt_with_two_jobs_stops_within_a_file_of_each(tmp_path):
+    inputs = bumpy_grids(tmp_path / "in", 6)
+    out = tmp_path / "out"
+
+    def progress(p):
+        raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        vertexflow.batch(inputs, out, jobs=2, threads=1, progress=progress)
+    # The file that raised, and at most the one the other job was working on.
+    assert 1 <= len([p for p in out.iterdir() if p.suffix == ".obj"]) <= 2
+
+
 def test_a_damaged_summary_is_a_warning_and_its_rows_are_measured_again(tmp_path):
     # Issue 32 item 4, through Python: one UserWarning naming the summary, every row measured.
     inputs = bumpy_grids(tmp_path / "in", 2)

@@ -192,7 +192,10 @@ stem. In a reference mode, a file without a reference fails (its error, not the 
 Failing files are reported and skipped; existing outputs are skipped unless force. Writes
 output_dir/batch_summary.csv and .json; returns {"files": [rows as enhance_file's], "done",
 "skipped", "failed", "seconds", "csv", "json"}. progress(dict) is called after each file
-(finished, total, failed, input, status, error, elapsed, eta).
+(finished, total, failed, input, status, error, elapsed, eta); an exception it raises
+(KeyboardInterrupt included; Ctrl-C does the same) stops the batch at the next file boundary, keeps the files
+written and the summary of those finished, and is raised again. An unreadable earlier summary in
+output_dir is named in a UserWarning, and the skipped files are measured again from their outputs.
 """)
 
 enhance_options = _front_end(

@@ -517,8 +517,12 @@ BatchSummary run_batch(const BatchOptions& options) {
   std::mutex mutex;
   std::size_t finished = 0, failed = 0, processed = 0;
   double processed_seconds = 0;
+  // What the progress callback threw: no file starts after it (see BatchOptions::progress).
+  std::exception_ptr stop;
+  std::atomic<bool> stopping{false};
+  std::vector<char> reported(count, 0);
   auto worker = [&] {
-    for (std::size_t i = next++; i < count; i = next++) {
+    for (std::size_t i = next++; i < count && !stopping; i = next++) {
       if (!preset[i]) summary.rows[i] = enhance_file(items[i].input, items[i].output, file_options, items[i].reference);
       BatchRow& row = summary.rows[i];
       if (row.status == "skipped") {
@@ -528,6 +532,7 @@ BatchSummary run_batch(const BatchOptions& options) {
         if (!kept && file_options.metrics) measure_output(items[i], file_options, mode_name, row);
       }
       const std::lock_guard lock(mutex);
+      reported[i] = 1;
       ++finished;
       if (row.status == "failed") ++failed;
       if (row.status != "skipped") {
@@ -545,7 +550,14 @@ BatchSummary run_batch(const BatchOptions& options) {
         if (processed > 0)
           p.eta = static_cast<double>(count - finished) * processed_seconds / static_cast<double>(processed) /
                   std::min<double>(options.jobs, std::max<std::size_t>(1, count - finished));
-        options.progress(p);
+        if (!stop) {
+          try {
+            options.progress(p);
+          } catch (...) {
+            stop = std::current_exception();
+            stopping = true;
+          }
+        }
       }
     }
   };
@@ -556,6 +568,13 @@ BatchSummary run_batch(const BatchOptions& options) {
     worker();
   }
   summary.seconds = seconds_since(start);
+  if (stop) {
+    // The files finished are kept, on disk and in the summary, so a rerun resumes after them.
+    std::vector<BatchRow> finished_rows;
+    for (std::size_t i = 0; i < count; ++i)
+      if (reported[i]) finished_rows.push_back(std::move(summary.rows[i]));
+    summary.rows = std::move(finished_rows);
+  }
   for (const BatchRow& row : summary.rows) {
     if (row.status == "done") ++summary.done;
     if (row.status == "skipped") ++summary.skipped;
@@ -571,6 +590,7 @@ BatchSummary run_batch(const BatchOptions& options) {
     j["jobs"] = options.jobs;
     j["threads_per_job"] = file_options.threads;
     j["mode"] = mode_name;
+    if (stop) j["stopped"] = "the progress callback raised an exception: the files not listed did not run";
     j["options"] = enhance_options_json(options.file.enhance);
     j["files"] = nlohmann::json::array();
     for (const BatchRow& row : summary.rows) j["files"].push_back(to_json(row));
@@ -579,6 +599,7 @@ BatchSummary run_batch(const BatchOptions& options) {
     write_text_file(summary.csv, batch_csv(summary.rows));
     write_text_file(summary.json, j.dump(2) + "\n");
   }
+  if (stop) std::rethrow_exception(stop);
   return summary;
 }
 

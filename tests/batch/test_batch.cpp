@@ -1,7 +1,8 @@
 // The batch engine (batch.h) and `vertexflow batch`: every mode, references from a manifest or a
 // directory, outputs bit for bit those of `vertexflow enhance`, summaries with each file's mode
 // and distances, a directory's own summaries never taken for inputs, a damaged summary named and
-// its rows measured again, hostile directory entries failing alike in directory and glob mode.
+// its rows measured again, hostile directory entries failing alike in directory and glob mode,
+// and a progress callback that throws stopping the batch.
 #include "shapes.h"
 #include "test_support.h"
 
@@ -332,6 +333,43 @@ TEST(Batch, HostileEntriesAreFailedRowsInDirectoryAndGlobModeAlike) {
   EXPECT_EQ(rows[0], expected) << rows[0].dump(1);
   EXPECT_EQ(rows[1], expected) << rows[1].dump(1);
   EXPECT_EQ(rows[2], expected) << rows[2].dump(1);
+}
+
+// Issue 32 item 7, in the engine: a progress callback that throws stops the batch at the next file
+// boundary; the files finished keep their outputs and summary rows, run_batch rethrows, and a
+// rerun resumes after them.
+TEST(Batch, AProgressCallbackThatThrowsStopsTheBatchAtTheNextFile) {
+  test::ScratchDir dir("batch-stop");
+  const auto in = three_meshes(dir);
+  const auto out = dir.file("out");
+  BatchOptions options;
+  options.inputs = {in.string()};
+  options.output_dir = out;
+  int calls = 0;
+  options.progress = [&calls](const BatchProgress&) {
+    ++calls;
+    throw std::runtime_error("cancelled");
+  };
+  try {
+    (void)run_batch(options);
+    ADD_FAILURE() << "run_batch returned";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "cancelled");
+  }
+  EXPECT_EQ(calls, 1);
+  EXPECT_TRUE(std::filesystem::exists(out / "cube.off"));
+  EXPECT_FALSE(std::filesystem::exists(out / "sphere.obj"));
+  EXPECT_FALSE(std::filesystem::exists(out / "torus.ply"));
+  const nlohmann::json stopped = nlohmann::json::parse(test::read_text(out / "batch_summary.json"));
+  ASSERT_EQ(stopped["files"].size(), 1u);
+  EXPECT_EQ(stopped["files"][0]["status"], "done");
+  EXPECT_TRUE(stopped.contains("stopped"));
+
+  options.progress = nullptr;
+  const BatchSummary resumed = run_batch(options);
+  EXPECT_EQ(resumed.skipped, 1u);
+  EXPECT_EQ(resumed.done, 2u);
+  EXPECT_EQ(measurements(to_json(resumed.rows[0])), measurements(stopped["files"][0]));
 }
 
 }  // namespace
