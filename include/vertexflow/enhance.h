@@ -161,9 +161,13 @@ struct EnhanceResult {
 /// zero area by mesh.h's bound, a repeat of an earlier face) stay in it, and their vertices are
 /// held, as are vertices without faces (the report's "face_list" counts them). Chart boundaries
 /// (texture seams, material and other label boundaries: docs/attributes.md) are creases for
-/// the flow (VertexConstraints::crease_edges) and are never flipped. Each moved vertex's
-/// attributes are re-sampled where it lands on the input surface, in each of its charts
-/// (the report's "attributes" section says how many and how far).
+/// the flow (VertexConstraints::crease_edges) and are never flipped. Seams stored cut open (copies
+/// of a vertex at the same position whose boundary edges pair up, as formats with one texture
+/// coordinate per vertex store them) are welded for the methods and held the same way, so every
+/// copy ends at one position and the result is the welded mesh's (the report's "cut_seams"
+/// section counts them). Each moved vertex's attributes are re-sampled where it lands on the
+/// input surface, in each of its charts (the report's "attributes" section says how many and how
+/// far).
 EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const EnhanceOptions& options,
                       const EnhanceCallbacks& callbacks = {});
 

@@ -2,6 +2,7 @@
 #include "attributes/transport.h"
 
 #include "mesh/closest_point.h"
+#include "mesh/fan_walk.h"
 
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
@@ -9,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <unordered_map>
 
 namespace vertexflow::attributes_detail {
 namespace {
@@ -333,9 +335,9 @@ MeshAttributes transport_attributes(const Mesh& input, const std::vector<Index>&
     }
   }
 
-  // Faces changed by edge flips take, at each corner, the row their vertex has in the old face
-  // around it that shares the most vertices with the new face (flips keep chart boundaries, so
-  // that face is in the same chart).
+  // Faces changed by edge flips take, at each corner, the row their vertex has on their side of
+  // any chart boundary around it: from the first face around the vertex that is unchanged or
+  // holds a chart-boundary half-edge (mesh/fan_walk.h; boundaries are never flipped).
   std::vector<char> face_changed(static_cast<std::size_t>(output_F.rows()), 0);
   std::vector<Index> flipped;
   for (Index f = 0; f < output_F.rows(); ++f) {
@@ -344,26 +346,52 @@ MeshAttributes transport_attributes(const Mesh& input, const std::vector<Index>&
     for (int k = 0; k < 3; ++k) changed |= moved.row(output_F(f, k)) != input.V.row(output_F(f, k));
     face_changed[static_cast<std::size_t>(f)] = changed;
   }
-  for (CornerChannel& c : out.corner) {
-    if (flipped.empty()) break;
-    const auto old_corners = c.corners;  // the rows of the faces as they were
+  if (!flipped.empty() && !out.corner.empty()) {
+    std::vector<char> at(static_cast<std::size_t>(n), 0);
     for (const Index f : flipped)
-      for (int k = 0; k < 3; ++k) {
-        const Index x = output_F(f, k);
-        int best_shared = -1;
-        std::int32_t row = -1;
-        for (Index i = topology.face_offsets[static_cast<std::size_t>(x)];
-             i < topology.face_offsets[static_cast<std::size_t>(x) + 1]; ++i) {
-          const Index face = faces[static_cast<std::size_t>(topology.vertex_faces[static_cast<std::size_t>(i)])];
-          int shared = 0;
-          for (int j = 0; j < 3; ++j) shared += corner_at(input.F, face, output_F(f, j)) >= 0;
-          if (shared > best_shared) {
-            best_shared = shared;
-            row = old_corners(face, corner_at(input.F, face, x));
-          }
+      for (int k = 0; k < 3; ++k) at[static_cast<std::size_t>(output_F(f, k))] = 1;
+    const HalfEdgeFaces around(output_F, at);
+    std::unordered_map<std::uint64_t, Index> boundary_face;  // directed chart-boundary half-edge -> input face
+    for (Index lf = 0; lf < topology.num_faces; ++lf)
+      for (int k = 0; k < 3; ++k)
+        if (flag[static_cast<std::size_t>(topology.face_edges(lf, k))]) {
+          const Index face = faces[static_cast<std::size_t>(lf)];
+          boundary_face[half_edge_key(input.F(face, k), input.F(face, (k + 1) % 3))] = face;
         }
-        c.corners(f, k) = row;
+    auto on_boundary = [&](Index a, Index b) {
+      return boundary_face.count(half_edge_key(a, b)) + boundary_face.count(half_edge_key(b, a)) > 0;
+    };
+    // Per flipped corner: the old face whose row it takes.
+    std::vector<std::array<Index, 3>> source(flipped.size());
+    for (std::size_t i = 0; i < flipped.size(); ++i)
+      for (int k = 0; k < 3; ++k) {
+        const Index f = flipped[i], x = output_F(f, k);
+        source[i][static_cast<std::size_t>(k)] = around.walk_around(
+            f, x,
+            [&](Index g, Index next, Index prev) -> Index {
+              if (output_F.row(g) == input.F.row(g)) return g;
+              if (const auto it = boundary_face.find(half_edge_key(x, next)); it != boundary_face.end())
+                return it->second;
+              if (const auto it = boundary_face.find(half_edge_key(prev, x)); it != boundary_face.end())
+                return it->second;
+              return -1;
+            },
+            [&](Index a, Index b) { return !on_boundary(a, b); });
+        // No boundary and no unchanged face around x: x is in one chart, any old face serves.
+        const auto first = static_cast<std::size_t>(topology.face_offsets[static_cast<std::size_t>(x)]);
+        if (source[i][static_cast<std::size_t>(k)] < 0 &&
+            first < static_cast<std::size_t>(topology.face_offsets[static_cast<std::size_t>(x) + 1]))
+          source[i][static_cast<std::size_t>(k)] = faces[static_cast<std::size_t>(topology.vertex_faces[first])];
       }
+    for (CornerChannel& c : out.corner) {
+      const auto old_corners = c.corners;  // the rows of the faces as they were
+      for (std::size_t i = 0; i < flipped.size(); ++i)
+        for (int k = 0; k < 3; ++k) {
+          const Index f = flipped[i], x = output_F(f, k), g = source[i][static_cast<std::size_t>(k)];
+          const int corner = g >= 0 ? corner_at(input.F, g, x) : -1;
+          c.corners(f, k) = corner >= 0 ? old_corners(g, corner) : -1;
+        }
+    }
   }
 
   // Normals from the moved geometry, the input's split kept.

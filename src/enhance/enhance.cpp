@@ -4,7 +4,9 @@
 
 #include "attributes/transport.h"
 #include "enhance/workable_faces.h"
+#include "mesh/cut_seams.h"
 #include "mesh/duplicate_faces.h"
+#include "mesh/fan_walk.h"
 
 #include "vertexflow/enhance_options.h"
 #include "vertexflow/report_json.h"
@@ -15,6 +17,9 @@
 
 #include <algorithm>
 #include <array>
+#include <optional>
+#include <unordered_map>
+#include <unordered_set>
 #include <utility>
 
 namespace vertexflow {
@@ -486,6 +491,63 @@ Faces face_rows(const Faces& F, const std::vector<Index>& faces) {
 
 }  // namespace enhance_detail
 
+namespace {
+
+// Where edge flips changed faces around a vertex that welds several input vertices (a cut-open
+// seam, mesh/cut_seams.h), which copy each changed face takes: the copy on its side of the seam,
+// from the first face around the vertex that is unchanged or holds a seam half-edge
+// (mesh/fan_walk.h).
+class SeamSides {
+ public:
+  // `work_F` are the methods' faces (rows `faces` of `input_F` through `to_work`), `output_F`
+  // the same after the flips; `copies` counts the input vertices of each work vertex.
+  SeamSides(const Faces& input_F, const std::vector<Index>& faces, const std::vector<Index>& to_work,
+            const std::vector<Index>& copies, const std::vector<std::array<Index, 2>>& seam_edges, const Faces& work_F,
+            const Faces& output_F)
+      : input_F_(input_F), faces_(faces), work_F_(work_F), output_F_(output_F), index_(output_F, welded(copies)) {
+    for (const auto& [a, b] : seam_edges) seam_.insert(half_edge_key(std::min(a, b), std::max(a, b)));
+    for (std::size_t i = 0; i < faces.size(); ++i)
+      for (int k = 0; k < 3; ++k) {
+        const Index v = input_F(faces[i], k), u = input_F(faces[i], (k + 1) % 3);
+        const Index w = to_work[static_cast<std::size_t>(v)], x = to_work[static_cast<std::size_t>(u)];
+        if (is_seam(w, x)) seam_side_[half_edge_key(w, x)] = {v, u};
+      }
+  }
+
+  // The input copy of work vertex w for output face f, or -1 if the walk finds none.
+  Index copy_for(Index f, Index w) const {
+    return index_.walk_around(
+        f, w,
+        [&](Index g, Index next, Index prev) -> Index {
+          if (output_F_.row(g) == work_F_.row(g))
+            for (int k = 0; k < 3; ++k)
+              if (work_F_(g, k) == w) return input_F_(faces_[static_cast<std::size_t>(g)], k);
+          if (const auto it = seam_side_.find(half_edge_key(w, next)); it != seam_side_.end()) return it->second[0];
+          if (const auto it = seam_side_.find(half_edge_key(prev, w)); it != seam_side_.end()) return it->second[1];
+          return -1;
+        },
+        [&](Index a, Index b) { return !is_seam(a, b); });
+  }
+
+ private:
+  static std::vector<char> welded(const std::vector<Index>& copies) {
+    std::vector<char> at(copies.size());
+    for (std::size_t w = 0; w < copies.size(); ++w) at[w] = copies[w] > 1;
+    return at;
+  }
+  bool is_seam(Index a, Index b) const { return seam_.count(half_edge_key(std::min(a, b), std::max(a, b))) > 0; }
+
+  const Faces& input_F_;
+  const std::vector<Index>& faces_;
+  const Faces& work_F_;
+  const Faces& output_F_;
+  HalfEdgeFaces index_;
+  std::unordered_set<std::uint64_t> seam_;
+  std::unordered_map<std::uint64_t, std::array<Index, 2>> seam_side_;  // directed -> input (from, to)
+};
+
+}  // namespace
+
 EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const EnhanceOptions& options,
                       const EnhanceCallbacks& callbacks) {
   validate_enhance_options(options, reference != nullptr, mesh.num_vertices());
@@ -496,16 +558,33 @@ EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const
   }
   const Index n = mesh.num_vertices();
   const std::vector<Index> faces = enhance_detail::workable_faces(mesh);
-  // Vertices of the faces kept out are held; vertices with no workable face are left out.
+  const bool all_faces = faces.size() == static_cast<std::size_t>(mesh.num_faces());
+  const Faces workable_F = all_faces ? Faces() : enhance_detail::face_rows(mesh.F, faces);
+  const Faces& input_F = all_faces ? mesh.F : workable_F;
+  std::optional<Topology> topology = build_topology(input_F, n);
+  // Seams stored cut open are welded for the methods and held as creases.
+  const CutSeams cut = find_cut_seams(mesh.V, input_F, *topology);
+  auto representative = [&](Index v) { return cut.empty() ? v : cut.representative[static_cast<std::size_t>(v)]; };
+
+  // Work vertices: the input vertices of workable faces, copies on a cut seam as one. Vertices
+  // of the faces kept out are held; vertices with no workable face are left out.
   std::vector<Index> to_work(static_cast<std::size_t>(n), -1);
   for (const Index f : faces)
     for (int k = 0; k < 3; ++k) to_work[static_cast<std::size_t>(mesh.F(f, k))] = 0;
-  std::vector<Index> to_input;
-  for (Index v = 0; v < n; ++v)
-    if (to_work[static_cast<std::size_t>(v)] == 0) {
-      to_work[static_cast<std::size_t>(v)] = static_cast<Index>(to_input.size());
+  std::vector<Index> to_input;  // the lowest input vertex of each work vertex
+  Index used = 0;
+  for (Index v = 0; v < n; ++v) {
+    Index& w = to_work[static_cast<std::size_t>(v)];
+    if (w < 0) continue;
+    ++used;
+    const Index r = representative(v);  // r <= v, and used
+    if (r != v) {
+      w = to_work[static_cast<std::size_t>(r)];
+    } else {
+      w = static_cast<Index>(to_input.size());
       to_input.push_back(v);
     }
+  }
   std::vector<char> held(static_cast<std::size_t>(n), 0);
   {
     std::vector<char> in_workable(static_cast<std::size_t>(mesh.num_faces()), 0);
@@ -514,21 +593,23 @@ EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const
       if (!in_workable[static_cast<std::size_t>(f)])
         for (int k = 0; k < 3; ++k) held[static_cast<std::size_t>(mesh.F(f, k))] = 1;
   }
-  const bool whole =
-      faces.size() == static_cast<std::size_t>(mesh.num_faces()) && to_input.size() == static_cast<std::size_t>(n);
-  if (whole && mesh.attributes.empty()) return enhance_clean(mesh, reference, options, callbacks);
+  const bool whole = all_faces && used == n && cut.empty();
+  if (whole && mesh.attributes.empty()) {
+    // The flow takes the topology; the other modes build what they need, so it goes now.
+    if (enhance_mode(options, reference != nullptr) != EnhanceMode::Flow) topology.reset();
+    return enhance_clean(mesh, reference, options, callbacks, topology ? &*topology : nullptr);
+  }
 
   // Chart boundaries (seams, material boundaries) are creases for the flow and never flipped.
-  const Faces workable_F = enhance_detail::face_rows(mesh.F, faces);
-  const Topology topology = build_topology(workable_F, n);
-  const attributes_detail::ChartBoundaries charts = attributes_detail::chart_boundaries(mesh, faces, topology);
+  const attributes_detail::ChartBoundaries charts = attributes_detail::chart_boundaries(mesh, faces, *topology);
   const std::vector<std::array<Index, 2>>& seams = charts.edges;
 
-  // The methods' mesh: the input itself when every face and vertex is workable, else the
-  // workable faces on the vertices they use.
+  // The methods' mesh: the input itself when every face and vertex is workable and nothing is
+  // welded, else the workable faces on the work vertices.
   Mesh work;
   if (!whole) work.comments = mesh.comments;
   const Mesh& methods_mesh = whole ? mesh : work;
+  auto work_of = [&](Index v) { return to_work[static_cast<std::size_t>(v)]; };
   EnhanceOptions o = options;
   o.constraints.pinned.clear();
   o.constraints.crease_edges.clear();
@@ -536,40 +617,61 @@ EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const
     work.V.resize(static_cast<Eigen::Index>(to_input.size()), 3);
     for (std::size_t w = 0; w < to_input.size(); ++w)
       work.V.row(static_cast<Eigen::Index>(w)) = mesh.V.row(to_input[w]);
-    work.F.resize(workable_F.rows(), 3);
-    for (Eigen::Index i = 0; i < workable_F.rows(); ++i)
-      for (int k = 0; k < 3; ++k) work.F(i, k) = to_work[static_cast<std::size_t>(workable_F(i, k))];
+    work.F.resize(input_F.rows(), 3);
+    for (Eigen::Index i = 0; i < input_F.rows(); ++i)
+      for (int k = 0; k < 3; ++k) work.F(i, k) = work_of(input_F(i, k));
   }
+  // The caller's pins as given (the report counts them), then the held vertices.
   for (const Index p : options.constraints.pinned)
-    if (to_work[static_cast<std::size_t>(p)] >= 0) o.constraints.pinned.push_back(to_work[static_cast<std::size_t>(p)]);
+    if (work_of(p) >= 0) o.constraints.pinned.push_back(work_of(p));
   Index vertices_held = 0;
   for (Index v = 0; v < n; ++v)
-    if (held[static_cast<std::size_t>(v)] && to_work[static_cast<std::size_t>(v)] >= 0) {
-      o.constraints.pinned.push_back(to_work[static_cast<std::size_t>(v)]);
+    if (held[static_cast<std::size_t>(v)] && work_of(v) >= 0) {
+      o.constraints.pinned.push_back(work_of(v));
       ++vertices_held;
     }
   for (const auto& [a, b] : options.constraints.crease_edges)
-    if (a >= 0 && b >= 0 && a < n && b < n && to_work[static_cast<std::size_t>(a)] >= 0 &&
-        to_work[static_cast<std::size_t>(b)] >= 0)
-      o.constraints.crease_edges.push_back(
-          {to_work[static_cast<std::size_t>(a)], to_work[static_cast<std::size_t>(b)]});
-  for (const auto& [a, b] : seams)
-    o.constraints.crease_edges.push_back({to_work[static_cast<std::size_t>(a)], to_work[static_cast<std::size_t>(b)]});
+    if (a >= 0 && b >= 0 && a < n && b < n && work_of(a) >= 0 && work_of(b) >= 0)
+      o.constraints.crease_edges.push_back({work_of(a), work_of(b)});
+  for (const auto& [a, b] : seams) o.constraints.crease_edges.push_back({work_of(a), work_of(b)});
+  std::vector<std::array<Index, 2>> cut_edges;  // in work vertices
+  for (const auto& [a, b] : cut.edges) cut_edges.push_back({work_of(a), work_of(b)});
+  o.constraints.crease_edges.insert(o.constraints.crease_edges.end(), cut_edges.begin(), cut_edges.end());
+  if (!cut.empty())
+    tell(callbacks.phase, fmt::format("{} seam edges are stored cut open: their {} vertex copies move as one, the "
+                                      "seams as creases",
+                                      cut.edges.size(), cut.vertices_welded));
 
   // The topology built for the seams is the flow's too when the methods work on the input.
-  EnhanceResult result = enhance_clean(methods_mesh, reference, o, callbacks, whole ? &topology : nullptr);
+  EnhanceResult result = enhance_clean(methods_mesh, reference, o, callbacks, whole ? &*topology : nullptr);
   Mesh out;
   if (whole) {
     out.V = std::move(result.mesh.V);
     out.F = std::move(result.mesh.F);
   } else {
     out.V = mesh.V;
-    for (std::size_t w = 0; w < to_input.size(); ++w)
-      out.V.row(to_input[w]) = result.mesh.V.row(static_cast<Eigen::Index>(w));
+    for (Index v = 0; v < n; ++v)
+      if (work_of(v) >= 0) out.V.row(v) = result.mesh.V.row(work_of(v));
     out.F = mesh.F;
-    for (std::size_t i = 0; i < faces.size(); ++i)
-      for (int k = 0; k < 3; ++k)
-        out.F(faces[i], k) = to_input[static_cast<std::size_t>(result.mesh.F(static_cast<Eigen::Index>(i), k))];
+    // Faces the edge flips left alone keep their input rows; changed ones take, at a welded
+    // vertex, the copy on their side of the seam.
+    std::vector<Index> copies(to_input.size(), 0);
+    for (Index v = 0; v < n; ++v)
+      if (work_of(v) >= 0) ++copies[static_cast<std::size_t>(work_of(v))];
+    std::optional<SeamSides> sides;
+    for (std::size_t i = 0; i < faces.size(); ++i) {
+      const auto row = static_cast<Eigen::Index>(i);
+      if (result.mesh.F.row(row) == work.F.row(row)) continue;
+      for (int k = 0; k < 3; ++k) {
+        const Index w = result.mesh.F(row, k);
+        Index v = to_input[static_cast<std::size_t>(w)];
+        if (copies[static_cast<std::size_t>(w)] > 1) {
+          if (!sides) sides.emplace(mesh.F, faces, to_work, copies, cut_edges, work.F, result.mesh.F);
+          if (const Index side = sides->copy_for(static_cast<Index>(i), w); side >= 0) v = side;
+        }
+        out.F(faces[i], k) = v;
+      }
+    }
   }
   out.comments = std::move(result.mesh.comments);
   const Index faces_held = mesh.num_faces() - static_cast<Index>(faces.size());
@@ -583,11 +685,13 @@ EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const
   result.report["face_list"] = {{"faces", mesh.num_faces()},
                                 {"faces_held", faces_held},
                                 {"vertices_held", vertices_held},
-                                {"vertices_without_faces", n - static_cast<Index>(to_input.size())}};
+                                {"vertices_without_faces", n - used}};
+  if (!cut.empty())
+    result.report["cut_seams"] = {{"edges", cut.edges.size()}, {"vertices_welded", cut.vertices_welded}};
   if (!mesh.attributes.empty()) {
     const auto start = Clock::now();
     attributes_detail::TransportReport t;
-    out.attributes = attributes_detail::transport_attributes(mesh, faces, topology, charts, out.V, out.F, t);
+    out.attributes = attributes_detail::transport_attributes(mesh, faces, *topology, charts, out.V, out.F, t);
     result.report["attributes"] = {
         {"chart_boundary_edges", seams.size()}, {"vertices_moved", t.vertices_moved},
         {"wedges_located", t.wedges_located},   {"max_location_distance_edges", t.max_location_distance},
