@@ -4,9 +4,12 @@
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <map>
+#include <regex>
 #include <set>
 #include <stdexcept>
 #include <system_error>
@@ -162,6 +165,71 @@ void require_finite_numbers(CLI::App& app) {
         ""));
   }
   for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) require_finite_numbers(*sub);
+}
+
+namespace {
+
+// "[-90, 90]", "> 0" or ">= 0" for a CLI11 range check, from its description ("FLOAT in [-90 -
+// 90]", "POSITIVE", "NONNEGATIVE"; CLI11 keeps no other trace of the bounds); empty for any
+// other check. The bounds are printed as CLI11 printed them (at most 6 digits), in plain numbers.
+std::string cli11_range_text(const std::string& description) {
+  if (description == "POSITIVE") return "> 0";
+  if (description == "NONNEGATIVE") return ">= 0";
+  std::smatch m;
+  if (!std::regex_match(description, m, std::regex(R"((?:INT|UINT|FLOAT) in \[(\S+) - (\S+)\])"))) return {};
+  if (std::strtod(m[2].str().c_str(), nullptr) >= 1e308) return ">= " + m[1].str();
+  return "[" + m[1].str() + ", " + m[2].str() + "]";
+}
+
+// Why `text` is not a value of an option of CLI11 type `type` (INT, UINT or FLOAT); empty if it
+// is one. Integers in decimal digits: CLI11's own conversion clamps an overflow to the largest
+// value silently and reads "-1" as 2^64 - 1 for an unsigned option.
+std::string not_a_number(const std::string& type, const std::string& text) {
+  const char* begin = text.data() + (text.rfind('+', 0) == 0 ? 1 : 0);
+  const char* end = text.data() + text.size();
+  if (type == "FLOAT") {
+    double value = 0;
+    return CLI::detail::lexical_cast(text, value) ? std::string() : "'" + text + "' is not a number";
+  }
+  std::from_chars_result r{};
+  if (type == "UINT") {
+    unsigned long long value = 0;
+    r = std::from_chars(begin, end, value);
+  } else {
+    long long value = 0;
+    r = std::from_chars(begin, end, value);
+  }
+  if (r.ec == std::errc::result_out_of_range && r.ptr == end) return text + " is too large";
+  if (r.ec != std::errc() || r.ptr != end || begin == end)
+    return "'" + text + "' is not " + (type == "UINT" ? "an integer >= 0" : "an integer");
+  return {};
+}
+
+}  // namespace
+
+void plain_option_messages(CLI::App& app) {
+  for (CLI::Option* option : app.get_options()) {
+    const std::string full_type = option->get_type_name();
+    const std::string type = full_type.substr(0, full_type.find(':'));
+    if (type != "INT" && type != "UINT" && type != "FLOAT") continue;
+    for (int i = 0;; ++i) {
+      CLI::Validator* check = nullptr;
+      try {
+        check = option->get_validator(i);  // throws past the last (CLI11 gives no count)
+      } catch (const CLI::OptionNotFound&) {
+        break;
+      }
+      const std::string range = cli11_range_text(check->get_description());
+      if (range.empty()) continue;
+      // The check still decides (its bounds exactly); only its words change.
+      check->operation([original = *check, range](std::string& text) {
+        return original(text).empty() ? std::string() : text + " is not in the allowed range (" + range + ")";
+      });
+    }
+    // First of all checks, so that no range check reads "abc" as out of range.
+    option->transform(CLI::Validator([type](std::string& text) { return not_a_number(type, text); }, ""));
+  }
+  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; })) plain_option_messages(*sub);
 }
 
 void add_enhance_options(CLI::App* command, GivenOptions& given, std::initializer_list<std::string_view> skip) {

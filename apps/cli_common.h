@@ -94,6 +94,14 @@ void add_enhance_options(CLI::App* command, GivenOptions& given, std::initialize
 /// after every command is registered.
 void require_finite_numbers(CLI::App& app);
 
+/// Words every numeric option's errors the same way, for `app` and its subcommands: a value that
+/// is not a number of the option's kind is "--flag: 'abc' is not a number" (not an integer, ...),
+/// and CLI11's range checks (CLI::Range, PositiveNumber, NonNegativeNumber) say "--flag: 100 is
+/// not in the allowed range ([-90, 90])", as the enhance option table does, where CLI11 would
+/// print its bounds with std::to_string (309 digits for an open range). Call it once, after
+/// every command is registered.
+void plain_option_messages(CLI::App& app);
+
 /// EnhanceOptions with the given values set (the rest at their defaults).
 EnhanceOptions enhance_options_from(const GivenOptions& given);
 

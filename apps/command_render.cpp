@@ -11,6 +11,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <map>
 
 namespace vertexflow::cli {
@@ -57,8 +58,10 @@ void register_render_command(CLI::App& app, const GlobalOptions& global) {
                       "none (default), or checker: a checkerboard laid on the mesh's texture coordinates (the first "
                       "texcoord channel, e.g. an OBJ's vt), dark and light grey over the shading and colour, so that "
                       "a texture that swims or stretches shows");
-  auto* squares = command->add_option("--checker-squares", o->render.checker_squares,
-                                      "--texture checker: squares per unit of texture coordinate (1..256, default 16)");
+  auto* squares = command
+                      ->add_option("--checker-squares", o->render.checker_squares,
+                                   "--texture checker: squares per unit of texture coordinate (1..256, default 16)")
+                      ->check(CLI::Range(1, 256));
   command->add_option("--before", o->before,
                       "The mesh before the flow (same vertices and order), for --color displacement");
   command->add_flag("--wireframe", o->wireframe, "Draw the edges on the surface");
@@ -142,10 +145,25 @@ void register_render_command(CLI::App& app, const GlobalOptions& global) {
     options.wireframe = o->wireframe;
     options.color_bar = !o->no_color_bar;
     options.color_limit = o->color_limit;
+    // What the options alone decide is checked before the mesh is read, so that the error names
+    // the option and not the input file (render_mesh would check these too, after the read).
+    if (options.shading == RenderShading::Exaggerated) {
+      const std::size_t expected = static_cast<std::size_t>(options.exaggerated.scales) + 1;
+      if (!o->weights.empty() && o->weights.size() != expected)
+        throw std::invalid_argument(fmt::format("--weights: {} values given for {} scales; expected {} (scales + 1)",
+                                                o->weights.size(), options.exaggerated.scales, expected));
+      for (const double w : o->weights)
+        if (w < 0) throw std::invalid_argument(fmt::format("--weights: {} is not in the allowed range (>= 0)", w));
+      if (!o->weights.empty() && std::all_of(o->weights.begin(), o->weights.end(), [](double w) { return w == 0; }))
+        throw std::invalid_argument("--weights: the weights sum to 0");
+      if (!o->light.empty() && options.exaggerated_light.norm() == 0)
+        throw std::invalid_argument("--light: 0,0,0 is not a direction");
+    }
+    if (options.color == RenderColor::Displacement && o->before.empty())
+      throw std::invalid_argument("--color displacement needs --before MESH");
 
     const Mesh mesh = read_mesh_with_warnings(o->input, global);
     if (options.color == RenderColor::Displacement) {
-      if (o->before.empty()) throw std::invalid_argument("--color displacement needs --before MESH");
       Mesh before = read_mesh_with_warnings(o->before, global);
       if (before.num_vertices() != mesh.num_vertices())
         throw IoError(fmt::format("{}: has {} vertices but {} has {}; displacement needs the same vertices", o->before,

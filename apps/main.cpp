@@ -40,6 +40,7 @@ int main(int argc, char** argv) {
   register_compare_command(app, global);
   register_batch_command(app, global);
   require_finite_numbers(app);
+  plain_option_messages(app);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {

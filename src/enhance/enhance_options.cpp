@@ -385,6 +385,8 @@ void check_option_value(const EnhanceOptionSpec& spec, const OptionValue& value,
                                                             : std::get<double>(value);
   const bool ok = std::isfinite(x) && (spec.min_open ? x > spec.min : x >= spec.min) &&
                   (spec.max_open ? x < spec.max : x <= spec.max);
+  // An unbounded option's only range is "finite": say so rather than "the allowed range (finite)".
+  if (!ok && !std::isfinite(spec.min) && !std::isfinite(spec.max)) fail(fmt::format("{} is not a finite number", x));
   if (!ok) fail(fmt::format("{} is not in the allowed range ({})", x, range_text(spec)));
 }
 

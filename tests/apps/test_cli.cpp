@@ -157,6 +157,98 @@ TEST(Cli, EveryFloatingPointOptionRefusesNanAndInfinity) {
   EXPECT_TRUE(std::filesystem::exists(good));
 }
 
+// Every numeric option's errors in the same words, from one place (cli_common's
+// plain_option_messages and the option table): the option as typed, the range in plain numbers,
+// one line, exit 1, and never the input file (issue 32 item 10: `--feature-angle inf` printed a
+// bound of 309 digits and exited 105; `--samples 1e20` and `--lambda abc` "could not convert").
+TEST(Cli, OptionErrorsNameTheOptionAndStateTheRangePlainly) {
+  test::ScratchDir dir("cli-option-errors");
+  const auto input = dir.file("in.obj");
+  std::ofstream(input) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  const auto lines_of = [](const std::string& text) {
+    std::vector<std::string> lines;
+    std::istringstream in(text);
+    for (std::string line; std::getline(in, line);) lines.push_back(line);
+    return lines;
+  };
+  std::vector<std::string> commands;
+  bool in_subcommands = false;
+  for (const std::string& line : lines_of(run_cli("--help").out)) {
+    if (line == "Subcommands:") in_subcommands = true;
+    std::smatch m;
+    if (in_subcommands && std::regex_match(line, m, std::regex(R"(  ([a-z][a-z-]*)\b.*)"))) commands.push_back(m[1]);
+  }
+  ASSERT_GE(commands.size(), 11u);
+  const std::regex numeric_option(R"(\s+(?:-\w,)?(--[\w-]+) (INT|UINT|FLOAT)(\S*)(?: x (\d+))?.*)");
+  const std::regex long_number(R"(\d{13})");
+  int checked = 0;
+  for (const std::string& command : commands) {
+    const std::string extension = command == "render" ? ".png" : command == "lines" ? ".svg" : ".obj";
+    const auto output = dir.file("out-" + command + (command == "batch" ? "" : extension));
+    for (const std::string& line : lines_of(run_cli(command + " --help").out)) {
+      std::smatch m;
+      if (!std::regex_match(line, m, numeric_option)) continue;
+      const std::string option = m[1], type = m[2];
+      const int count = m[4].matched ? std::stoi(m[4]) : 1;
+      const auto run = [&](const std::string& bad) {
+        std::string values = bad;
+        for (int i = 1; i < count; ++i) values += " 1";
+        const std::string arguments = command + " " + test::quoted(input) + " " + test::quoted(output) + " " + option +
+                                      " " + values + (command == "render" || command == "lines" ? " --size 32x32" : "");
+        ++checked;
+        return std::make_pair(arguments, run_cli(arguments));
+      };
+      // Not a number of the option's kind: said so, naming the option.
+      const auto [arguments, r] = run("abc");
+      const std::string kind = type == "FLOAT" ? "a number" : type == "UINT" ? "an integer >= 0" : "an integer";
+      EXPECT_EQ(r.exit_code, 1) << arguments;
+      EXPECT_EQ(r.err, "vertexflow: error: " + option + ": 'abc' is not " + kind + "\n") << arguments;
+      // Far below any range (every CLI11 range here is above -1e300): the range in plain numbers.
+      const auto [low_arguments, low] = run(type == "FLOAT" ? "-1e300" : "-1");
+      if (!m[3].str().empty()) {
+        EXPECT_EQ(low.exit_code, 1) << low_arguments;  // a CLI11 check: refused
+      }
+      if (low.exit_code != 0) {
+        // "--x: VALUE ...", or "--x does not apply to ..." of the enhance modes.
+        EXPECT_EQ(low.err.rfind("vertexflow: error: " + option, 0), 0u) << low_arguments << "\n" << low.err;
+        EXPECT_EQ(std::count(low.err.begin(), low.err.end(), '\n'), 1) << low_arguments << "\n" << low.err;
+        EXPECT_FALSE(std::regex_search(low.err, long_number)) << low_arguments << "\n" << low.err;
+        EXPECT_EQ(low.err.find(input.filename().string()), std::string::npos) << low_arguments << "\n" << low.err;
+      }
+      std::filesystem::remove_all(output);
+    }
+  }
+  EXPECT_GT(checked, 150);
+  // The issue's own and a few more, word for word.
+  const struct {
+    std::string arguments, error;
+  } cases[] = {
+      {"enhance IN o.obj --feature-angle inf", "--feature-angle: inf is not in the allowed range (>= 0)"},
+      {"enhance IN o.obj --lambda nan", "--lambda: nan is not in the allowed range (> 0)"},
+      {"enhance IN o.obj --iterations 1e9", "--iterations: '1e9' is not an integer"},
+      {"enhance IN o.obj --iterations 99999999999999999999", "--iterations: 99999999999999999999 is too large"},
+      {"enhance IN o.obj --method unsharp --weight inf", "--weight: inf is not a finite number"},
+      {"render IN o.png --exaggeration -1", "--exaggeration: -1 is not in the allowed range (> 0)"},
+      {"render IN o.png --elevation 100", "--elevation: 100 is not in the allowed range ([-90, 90])"},
+      {"render IN o.png --samples 1e20", "--samples: '1e20' is not an integer"},
+      {"lines IN o.svg --line-width 100", "--line-width: 100 is not in the allowed range ([0.1, 16])"},
+      {"remesh IN o.obj --edge-length 0", "--edge-length: 0 is not in the allowed range (> 0)"},
+      {"compare IN IN --seed -1", "--seed: '-1' is not an integer >= 0"},
+      {"batch IN out -j 0", "--jobs: 0 is not in the allowed range ([1, 1024])"},
+      // Checks of options against each other come before the mesh is read, naming no file.
+      {"render IN o.png --shading exaggerated --weights 1,2",
+       "--weights: 2 values given for 4 scales; expected 5 (scales + 1)"},
+      {"render IN o.png --shading exaggerated --light 0,0,0", "--light: 0,0,0 is not a direction"},
+      {"render IN o.png --color displacement", "--color displacement needs --before MESH"},
+  };
+  for (const auto& c : cases) {
+    const std::string arguments = std::regex_replace(c.arguments, std::regex("IN"), test::quoted(input));
+    const auto r = run_cli("-q " + arguments);
+    EXPECT_EQ(r.exit_code, 1) << arguments;
+    EXPECT_EQ(r.err, "vertexflow: error: " + c.error + "\n") << arguments;
+  }
+}
+
 TEST(Cli, UsageErrorsFail) {
   EXPECT_NE(run_cli("").exit_code, 0);
   EXPECT_NE(run_cli("info").exit_code, 0);
@@ -336,7 +428,7 @@ TEST(CliEnhance, NonFiniteOptionsAreOneLineNamingTheFlag) {
                {"--min-quality nan", "--min-quality: nan is not in the allowed range ([0, 1])"},
                {"--feature-angle nan", "--feature-angle: nan is not in the allowed range (>= 0)"},
                {"--lambda -2", "--lambda: -2 is not in the allowed range (> 0)"},
-               {"--method unsharp --weight inf", "--weight: inf is not in the allowed range (finite)"}};
+               {"--method unsharp --weight inf", "--weight: inf is not a finite number"}};
   for (const auto& c : cases) {
     const auto r = run_cli("--quiet enhance " + shell_quote(input) + " " + shell_quote(out.string()) + " " + c.options +
                            " --report " + shell_quote(report.string()));
