@@ -20,8 +20,13 @@ struct CameraCliOptions {
 /// Registers the camera options on `command`.
 void add_camera_options(CLI::App* command, CameraCliOptions& camera);
 
-/// WIDTHxHEIGHT (--size) as (width, height). Throws std::invalid_argument when malformed.
+/// WIDTHxHEIGHT (--size) as (width, height). Throws std::invalid_argument naming --size when
+/// malformed or when a side is outside render.h's [16, 8192].
 std::pair<int, int> parse_image_size(const std::string& size);
+
+/// A check of --size as it is parsed (parse_image_size), so that its error comes before any mesh
+/// is read and names no mesh file.
+CLI::Validator image_size_check();
 
 /// A box as JSON: [xmin, ymin, zmin, xmax, ymax, zmax], as --frame takes it.
 nlohmann::json box_json(const BoundingBox& box);

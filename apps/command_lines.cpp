@@ -148,7 +148,7 @@ void register_compare_lines_command(CLI::App& app, const GlobalOptions& global) 
       ->check(CLI::Range(1, 360));
   command->add_option("--elevation", o->fidelity.elevation_degrees, "Degrees above the xz plane (default 15)")
       ->check(CLI::Range(-90.0, 90.0));
-  command->add_option("--size", o->size, "Image size WxH per view (default 800x600)");
+  command->add_option("--size", o->size, "Image size WxH per view (default 800x600)")->check(image_size_check());
   command->add_option("--match-pixels", o->fidelity.match_pixels, "Chamfer radius in pixels (default 2)")
       ->check(CLI::NonNegativeNumber);
   add_line_options(command, o->lines);

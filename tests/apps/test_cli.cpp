@@ -249,6 +249,35 @@ TEST(Cli, OptionErrorsNameTheOptionAndStateTheRangePlainly) {
   }
 }
 
+// --size is checked as it is parsed: the range, not "expected WIDTHxHEIGHT", for a size of the
+// right form, and no mesh file named (issue 32 item 11).
+TEST(Cli, ImageSizeOutOfRangeStatesTheRange) {
+  test::ScratchDir dir("cli-image-size");
+  const auto input = dir.file("in.obj"), output = dir.file("out.png");
+  std::ofstream(input) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  for (const std::string command : {"render", "lines", "compare-lines"}) {
+    for (const std::string size : {"100000x100000", "40000x40000", "8x8", "16x99999999999999999999"}) {
+      const std::string arguments =
+          command + " " + test::quoted(input) + " " +
+          (command == "compare-lines" ? test::quoted(input)
+                                      : test::quoted(command == "lines" ? dir.file("out.svg") : output)) +
+          " --size " + size;
+      const auto r = run_cli(arguments);
+      EXPECT_EQ(r.exit_code, 1) << arguments;
+      EXPECT_EQ(r.err, "vertexflow: error: --size " + size + ": width and height must each be in [16, 8192] pixels\n")
+          << arguments;
+    }
+    const auto malformed =
+        run_cli(command + " " + test::quoted(input) + " " + test::quoted(dir.file("o.svg")) + " --size 100000by100000");
+    EXPECT_EQ(malformed.err, "vertexflow: error: --size 100000by100000: expected WIDTHxHEIGHT, e.g. 1600x1200\n");
+  }
+  EXPECT_FALSE(std::filesystem::exists(output));
+  // Leading zeros are digits like any other.
+  const auto r = run_cli("render " + test::quoted(input) + " " + test::quoted(output) + " --size 00064x048");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_TRUE(std::filesystem::exists(output));
+}
+
 TEST(Cli, UsageErrorsFail) {
   EXPECT_NE(run_cli("").exit_code, 0);
   EXPECT_NE(run_cli("info").exit_code, 0);
