@@ -19,6 +19,7 @@
 #include <optional>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 namespace vertexflow {
 
@@ -150,13 +151,12 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
     const Vertices start_of_round = X;
     // One solve: minimise the energy for positions X, frozen curvature of X.
     auto start = Clock::now();
-    const FlowFrame frame = surface
-                                ? flow_frame_on_reference(X, F, topology, options, setup.sliver_faces, *surface, fixed)
-                                : flow_frame(X, F, topology, options, setup.sliver_faces);
+    FlowFrame frame = surface ? flow_frame_on_reference(X, F, topology, options, setup.sliver_faces, *surface, fixed)
+                              : flow_frame(X, F, topology, options, setup.sliver_faces);
     if (round == 0 && options.density.passes > 0) surface_curvature = frame.curvature;
     report.d = frame.d;
     report.seconds_curvature += seconds_since(start);
-    X = solver.solve(frame, options.weights, report);
+    X = solver.solve(std::move(frame), options.weights, report);  // frees its curvature once assembled
     if (!X.allFinite()) throw std::runtime_error("vertex flow: the solver diverged");
     if (options.project_to_input) {
       start = Clock::now();

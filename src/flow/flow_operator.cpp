@@ -6,6 +6,8 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <utility>
+#include <vector>
 
 namespace vertexflow {
 namespace {
@@ -99,12 +101,12 @@ double FlowOperator::passes(const BlockVector& x, BlockVector& y, bool with_d, b
 
 BlockSparseMatrix galerkin_upper(const FlowTerms& t, const AggregationCoarseSpace& space) {
   const auto n = static_cast<std::size_t>(t.n);
+  const auto na = static_cast<std::size_t>(space.size());
   // Per vertex i (the rows of A at i, fixed vertices included): for each aggregate a whose
   // basis function is non-zero on the star of i, phi_a(i), the 3x3 block (G Phi_a)_i and the
-  // entry (L phi_a)_i.
-  // Sizes first (the distinct aggregates of the star's basis functions), so that the locals
-  // take what they need: reserving the worst case per vertex tripled amo's peak memory.
+  // entry (L phi_a)_i: its "locals". First their number and the range of their aggregates.
   std::vector<std::uint32_t> local_size(n, 0);
+  std::vector<Index> lowest(n, static_cast<Index>(na)), highest(n, -1);
   tbb::enumerable_thread_specific<std::vector<Index>> seen;
   parallel_for_index(t.n, [&](Index i) {
     std::vector<Index>& aggregates = seen.local();  // distinct, a handful: linear search
@@ -114,72 +116,106 @@ BlockSparseMatrix galerkin_upper(const FlowTerms& t, const AggregationCoarseSpac
         if (std::find(aggregates.begin(), aggregates.end(), w.aggregate) == aggregates.end())
           aggregates.push_back(w.aggregate);
     });
-    local_size[static_cast<std::size_t>(i)] = static_cast<std::uint32_t>(aggregates.size());
-  });
-  std::vector<std::size_t> local_start(n + 1, 0);
-  for (std::size_t i = 0; i < n; ++i) local_start[i + 1] = local_start[i] + local_size[i];
-  std::vector<Local> locals(local_start[n]);
-  parallel_for_index(t.n, [&](Index i) {
     const auto v = static_cast<std::size_t>(i);
-    Local* out = locals.data() + local_start[v];
-    std::uint32_t size = 0;
-    auto find = [&](Index a) -> Local& {
-      for (std::uint32_t k = 0; k < size; ++k)
-        if (out[k].aggregate == a) return out[k];
-      out[size] = Local{a, 0, Eigen::Matrix3d::Zero(), 0};
-      return out[size++];
-    };
-    const Eigen::Matrix3d G = t.G[v].full(), K = t.K[v].full();
-    for (const AggregationCoarseSpace::Weight& w : space.basis(i)) {
-      Local& x = find(w.aggregate);
-      x.phi = w.value;
-      x.g += w.value * G;
-      x.l += w.value;
+    local_size[v] = static_cast<std::uint32_t>(aggregates.size());
+    for (const Index a : aggregates) {
+      lowest[v] = std::min(lowest[v], a);
+      highest[v] = std::max(highest[v], a);
     }
-    const auto [begin, end] = t.one_ring(i);
-    for (const Index* j = begin; j != end; ++j) {
-      const Eigen::Matrix3d coupling = K + t.K[static_cast<std::size_t>(*j)].full();
-      for (const AggregationCoarseSpace::Weight& w : space.basis(*j)) {
-        Local& x = find(w.aggregate);
-        x.g -= w.value * coupling;
-        x.l -= t.inv_degree[v] * w.value;
-      }
-    }
-    std::sort(out, out + size, [](const Local& x, const Local& y) { return x.aggregate < y.aggregate; });
   });
-  // The locals of each aggregate, by vertex (counting sort, so in vertex order).
-  const auto na = static_cast<std::size_t>(space.size());
-  std::vector<std::size_t> touch_start(na + 1, 0);
-  for (std::size_t i = 0; i < n; ++i)
-    for (std::size_t k = 0; k < local_size[i]; ++k)
-      ++touch_start[static_cast<std::size_t>(locals[local_start[i] + k].aggregate) + 1];
-  for (std::size_t a = 0; a < na; ++a) touch_start[a + 1] += touch_start[a];
-  std::vector<std::pair<Index, std::uint32_t>> touches(touch_start[na]);
-  {
-    std::vector<std::size_t> fill(touch_start.begin(), touch_start.end() - 1);
+
+  // The rows are built for a range of aggregates at a time, from the locals of the vertices that
+  // touch it only: the locals of all vertices at once (96 bytes each, about 5.6 per vertex) were
+  // the flow's peak memory on large meshes (540 of 2,129 bytes per vertex at 2.8M vertices,
+  // docs/benchmarks.md). Vertices and aggregates are numbered along the surface, so a range's
+  // vertices are about its share; a vertex on a range's edge computes its locals twice. Each
+  // block is still summed over the vertices in order, so the matrix does not depend on the
+  // ranges.
+  constexpr std::size_t kRanges = 32, kMinRange = 4096;
+  const std::size_t range = std::max(kMinRange, (na + kRanges - 1) / kRanges);
+  std::vector<BlockSparseMatrix> parts;
+  std::vector<Index> vertices;
+  std::vector<std::size_t> local_start;
+  std::vector<Local> locals;
+  for (std::size_t a0 = 0; a0 < na; a0 += range) {
+    const std::size_t a1 = std::min(na, a0 + range);
+    vertices.clear();
     for (std::size_t i = 0; i < n; ++i)
-      for (std::uint32_t k = 0; k < local_size[i]; ++k)
-        touches[fill[static_cast<std::size_t>(locals[local_start[i] + k].aggregate)]++] = {static_cast<Index>(i), k};
-  }
-  // Row a of the upper half of H_c: blocks (a, b), b >= a, summed over the vertices in order.
-  return build_block_rows(space.size(), space.size(), [&](int a, BlockRowAccumulator& row) {
-    for (std::size_t m = touch_start[static_cast<std::size_t>(a)]; m < touch_start[static_cast<std::size_t>(a) + 1];
-         ++m) {
-      const auto [i, k] = touches[m];
+      if (local_size[i] > 0 && static_cast<std::size_t>(lowest[i]) < a1 && static_cast<std::size_t>(highest[i]) >= a0)
+        vertices.push_back(static_cast<Index>(i));
+    const std::size_t m = vertices.size();
+    local_start.assign(m + 1, 0);
+    for (std::size_t c = 0; c < m; ++c)
+      local_start[c + 1] = local_start[c] + local_size[static_cast<std::size_t>(vertices[c])];
+    locals.assign(local_start[m], Local{});
+    parallel_for_index(static_cast<Index>(m), [&](Index c) {
+      const Index i = vertices[static_cast<std::size_t>(c)];
       const auto v = static_cast<std::size_t>(i);
-      const Local* local = locals.data() + local_start[v];
-      const Local& x = local[k];
-      const Eigen::Matrix3d left = x.g * t.P[v].full();
-      const Eigen::Matrix3d D = t.D[v].full();             // phi is 0 at fixed vertices, so their D drops out
-      for (std::uint32_t q = k; q < local_size[v]; ++q) {  // sorted, so local[q].aggregate >= a
-        const Local& y = local[q];
-        Eigen::Matrix3d& block = row[y.aggregate];
-        block.noalias() += left * y.g;
-        block.diagonal().array() += t.smooth[v] * x.l * y.l;
-        block.noalias() += (x.phi * y.phi) * D;
+      Local* out = locals.data() + local_start[static_cast<std::size_t>(c)];
+      std::uint32_t size = 0;
+      auto find = [&](Index a) -> Local& {
+        for (std::uint32_t k = 0; k < size; ++k)
+          if (out[k].aggregate == a) return out[k];
+        out[size] = Local{a, 0, Eigen::Matrix3d::Zero(), 0};
+        return out[size++];
+      };
+      const Eigen::Matrix3d G = t.G[v].full(), K = t.K[v].full();
+      for (const AggregationCoarseSpace::Weight& w : space.basis(i)) {
+        Local& x = find(w.aggregate);
+        x.phi = w.value;
+        x.g += w.value * G;
+        x.l += w.value;
       }
+      const auto [begin, end] = t.one_ring(i);
+      for (const Index* j = begin; j != end; ++j) {
+        const Eigen::Matrix3d coupling = K + t.K[static_cast<std::size_t>(*j)].full();
+        for (const AggregationCoarseSpace::Weight& w : space.basis(*j)) {
+          Local& x = find(w.aggregate);
+          x.g -= w.value * coupling;
+          x.l -= t.inv_degree[v] * w.value;
+        }
+      }
+      std::sort(out, out + size, [](const Local& x, const Local& y) { return x.aggregate < y.aggregate; });
+    });
+    // The locals of each aggregate of the range, by vertex (counting sort, so in vertex order).
+    std::vector<std::size_t> touch_start(a1 - a0 + 1, 0);
+    for (const Local& x : locals)
+      if (static_cast<std::size_t>(x.aggregate) >= a0 && static_cast<std::size_t>(x.aggregate) < a1)
+        ++touch_start[static_cast<std::size_t>(x.aggregate) - a0 + 1];
+    for (std::size_t a = a0; a < a1; ++a) touch_start[a - a0 + 1] += touch_start[a - a0];
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> touches(touch_start.back());  // (vertex in range, k)
+    {
+      std::vector<std::size_t> fill(touch_start.begin(), touch_start.end() - 1);
+      for (std::size_t c = 0; c < m; ++c)
+        for (std::size_t k = local_start[c]; k < local_start[c + 1]; ++k) {
+          const auto a = static_cast<std::size_t>(locals[k].aggregate);
+          if (a >= a0 && a < a1)
+            touches[fill[a - a0]++] = {static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(k - local_start[c])};
+        }
     }
-  });
+    // Row a of the upper half of H_c: blocks (a, b), b >= a, summed over the vertices in order.
+    parts.push_back(
+        build_block_rows(static_cast<int>(a1 - a0), static_cast<int>(na), [&](int r, BlockRowAccumulator& row) {
+          for (std::size_t e = touch_start[static_cast<std::size_t>(r)];
+               e < touch_start[static_cast<std::size_t>(r) + 1]; ++e) {
+            const auto [c, k] = touches[e];
+            const auto v = static_cast<std::size_t>(vertices[c]);
+            const Local* local = locals.data() + local_start[c];
+            const Local& x = local[k];
+            const Eigen::Matrix3d left = x.g * t.P[v].full();
+            const Eigen::Matrix3d D = t.D[v].full();             // phi is 0 at fixed vertices, so their D drops out
+            for (std::uint32_t q = k; q < local_size[v]; ++q) {  // sorted, so local[q].aggregate >= a
+              const Local& y = local[q];
+              Eigen::Matrix3d& block = row[y.aggregate];
+              block.noalias() += left * y.g;
+              block.diagonal().array() += t.smooth[v] * x.l * y.l;
+              block.noalias() += (x.phi * y.phi) * D;
+            }
+          }
+        }));
+  }
+  std::vector<Local>().swap(locals);
+  return stack_block_rows(std::move(parts), static_cast<int>(na));
 }
 
 }  // namespace vertexflow

@@ -220,11 +220,24 @@ FlowSystemSolver::FlowSystemSolver(const Topology& topology, std::vector<char> f
 FlowSystemSolver::~FlowSystemSolver() = default;
 
 Vertices FlowSystemSolver::solve(const FlowFrame& frame, const EnergyWeights& weights, FlowReport& report) {
+  return solve(frame, nullptr, weights, report);
+}
+
+Vertices FlowSystemSolver::solve(FlowFrame&& frame, const EnergyWeights& weights, FlowReport& report) {
+  return solve(frame, &frame, weights, report);
+}
+
+Vertices FlowSystemSolver::solve(const FlowFrame& frame, FlowFrame* release, const EnergyWeights& weights,
+                                 FlowReport& report) {
   Impl& s = *impl_;
   const Index m = s.num_free();
   auto start = Clock::now();
   s.number_vertices(frame.P);
   const FlowTerms terms = make_flow_terms(s.topology, s.fixed, frame, weights, s.order);
+  if (release) {  // only P is read from here on
+    release->curvature = Curvature();
+    std::vector<Eigen::Matrix3d>().swap(release->sliver_stiffness);
+  }
   FlowOperator op(terms);
   const BlockVector b = op.right_hand_side(to_local(terms, frame.P.data()));
   report.seconds_assembly += seconds_since(start);

@@ -72,9 +72,20 @@ void AggregationCoarseSpace::restrict_to(const BlockVector& r, BlockVector& coar
   parallel_for_index(count_, restrict_one, 1024, kSerialAggregatesBelow);
 }
 
+namespace {
+
+// The symmetric matrix, with the upper half freed before the hierarchy is built from it.
+BlockSparseMatrix symmetric_releasing(BlockSparseMatrix& upper) {
+  BlockSparseMatrix symmetric = symmetric_from_upper(upper);
+  upper = BlockSparseMatrix();
+  return symmetric;
+}
+
+}  // namespace
+
 CoarseSpaceCorrection::CoarseSpaceCorrection(std::shared_ptr<const AggregationCoarseSpace> space,
-                                             const BlockSparseMatrix& galerkin_upper)
-    : space_(std::move(space)), coarse_(std::make_unique<AdditiveMultilevel>(symmetric_from_upper(galerkin_upper))) {
+                                             BlockSparseMatrix galerkin_upper)
+    : space_(std::move(space)), coarse_(std::make_unique<AdditiveMultilevel>(symmetric_releasing(galerkin_upper))) {
   restricted_.resize(3 * space_->size());
 }
 

@@ -60,7 +60,7 @@ class CoarseSpaceCorrection : public PreconditionerCorrection {
  public:
   /// `galerkin_upper`: the upper half (diagonal included) of Phi^T H Phi. Throws
   /// std::runtime_error if its coarsest level is not numerically positive definite.
-  CoarseSpaceCorrection(std::shared_ptr<const AggregationCoarseSpace> space, const BlockSparseMatrix& galerkin_upper);
+  CoarseSpaceCorrection(std::shared_ptr<const AggregationCoarseSpace> space, BlockSparseMatrix galerkin_upper);
   double add_to(const BlockVector& r, BlockVector& z) override;
 
  private:

@@ -120,46 +120,107 @@ std::vector<std::pair<int, Matrix3>> BlockRowAccumulator::take() {
 }
 
 BlockSparseMatrix build_block_rows(int rows, int cols, const std::function<void(int, BlockRowAccumulator&)>& body) {
-  std::vector<std::vector<std::pair<int, Matrix3>>> built(static_cast<std::size_t>(rows));
-  tbb::enumerable_thread_specific<BlockRowAccumulator> accumulators([cols] { return BlockRowAccumulator(cols); });
-  // Always in parallel: unlike the per-iteration products, a set-up row costs many blocks.
-  tbb::parallel_for(tbb::blocked_range<int>(0, rows, 16), [&](const tbb::blocked_range<int>& range) {
-    BlockRowAccumulator& accumulator = accumulators.local();
-    for (int k = range.begin(); k != range.end(); ++k) {
-      body(k, accumulator);
-      built[static_cast<std::size_t>(k)] = accumulator.take();
-    }
-  });
+  // Rows are built a range at a time and appended, so that rows under construction exist for
+  // one range only: all of them beside the finished matrix were twice its size, the peak of the
+  // multilevel set-up on large meshes (docs/benchmarks.md). The first range's density sizes the
+  // arrays (with a margin), so that they rarely grow, and never by copying most of the matrix.
+  constexpr int kRangeRows = 8192;
   BlockSparseMatrix A;
   A.rows = rows;
   A.cols = cols;
   A.start.assign(static_cast<std::size_t>(rows) + 1, 0);
-  for (int k = 0; k < rows; ++k)
-    A.start[static_cast<std::size_t>(k) + 1] =
-        A.start[static_cast<std::size_t>(k)] + static_cast<int>(built[static_cast<std::size_t>(k)].size());
-  A.column.resize(static_cast<std::size_t>(A.start.back()));
-  A.block.resize(static_cast<std::size_t>(A.start.back()));
-  parallel_rows(rows, [&](int k) {
-    auto m = static_cast<std::size_t>(A.start[static_cast<std::size_t>(k)]);
-    for (const auto& [column, block] : built[static_cast<std::size_t>(k)]) {
-      A.column[m] = column;
-      A.block[m++] = block;
+  tbb::enumerable_thread_specific<BlockRowAccumulator> accumulators([cols] { return BlockRowAccumulator(cols); });
+  std::vector<std::vector<std::pair<int, Matrix3>>> built;
+  for (int r0 = 0; r0 < rows; r0 += kRangeRows) {
+    const int r1 = std::min(rows, r0 + kRangeRows);
+    built.assign(static_cast<std::size_t>(r1 - r0), {});
+    // Always in parallel: unlike the per-iteration products, a set-up row costs many blocks.
+    tbb::parallel_for(tbb::blocked_range<int>(r0, r1, 16), [&](const tbb::blocked_range<int>& range) {
+      BlockRowAccumulator& accumulator = accumulators.local();
+      for (int k = range.begin(); k != range.end(); ++k) {
+        body(k, accumulator);
+        built[static_cast<std::size_t>(k - r0)] = accumulator.take();
+      }
+    });
+    std::size_t blocks = 0;
+    for (const auto& row : built) blocks += row.size();
+    if (r0 == 0) {
+      const double per_row = static_cast<double>(blocks) / (r1 - r0);
+      const auto expected = static_cast<std::size_t>(1.05 * per_row * rows) + blocks;
+      A.column.reserve(expected);
+      A.block.reserve(expected);
     }
-  });
+    for (int k = r0; k < r1; ++k) {
+      auto& row = built[static_cast<std::size_t>(k - r0)];
+      A.start[static_cast<std::size_t>(k) + 1] = A.start[static_cast<std::size_t>(k)] + static_cast<int>(row.size());
+      for (const auto& [column, block] : row) {
+        A.column.push_back(column);
+        A.block.push_back(block);
+      }
+      std::vector<std::pair<int, Matrix3>>().swap(row);
+    }
+  }
+  return A;
+}
+
+BlockSparseMatrix stack_block_rows(std::vector<BlockSparseMatrix>&& parts, int cols) {
+  BlockSparseMatrix A;
+  A.cols = cols;
+  std::size_t blocks = 0;
+  for (const BlockSparseMatrix& part : parts) {
+    A.rows += part.rows;
+    blocks += part.column.size();
+  }
+  A.start.reserve(static_cast<std::size_t>(A.rows) + 1);
+  A.column.reserve(blocks);
+  A.block.reserve(blocks);
+  for (BlockSparseMatrix& part : parts) {
+    const int offset = A.start.back();
+    for (int k = 0; k < part.rows; ++k) A.start.push_back(offset + part.start[static_cast<std::size_t>(k) + 1]);
+    A.column.insert(A.column.end(), part.column.begin(), part.column.end());
+    A.block.insert(A.block.end(), part.block.begin(), part.block.end());
+    part = BlockSparseMatrix();
+  }
   return A;
 }
 
 BlockSparseMatrix symmetric_from_upper(const BlockSparseMatrix& upper) {
-  // Row k of the result: the strictly lower blocks (row k of upper's transpose, columns < k),
-  // then row k of upper (columns >= k); both parts are sorted, so the row is.
-  const BlockSparseMatrix lower = transpose(upper);
-  return build_block_rows(upper.rows, upper.cols, [&](int k, BlockRowAccumulator& row) {
-    for (int m = lower.start[static_cast<std::size_t>(k)]; m < lower.start[static_cast<std::size_t>(k) + 1]; ++m)
-      if (lower.column[static_cast<std::size_t>(m)] != k)
-        row[lower.column[static_cast<std::size_t>(m)]] = lower.block[static_cast<std::size_t>(m)];
-    for (int m = upper.start[static_cast<std::size_t>(k)]; m < upper.start[static_cast<std::size_t>(k) + 1]; ++m)
-      row[upper.column[static_cast<std::size_t>(m)]] = upper.block[static_cast<std::size_t>(m)];
+  // Row k: the strictly lower blocks (upper's blocks (r, k), r < k, transposed, in order of r),
+  // then row k of upper (columns >= k); both parts are sorted, so the row is. Written straight
+  // into place: a transpose and rows under construction (build_block_rows) beside it were the
+  // flow's peak memory on large meshes once the Galerkin product was built in ranges.
+  const auto rows = static_cast<std::size_t>(upper.rows);
+  BlockSparseMatrix S;
+  S.rows = upper.rows;
+  S.cols = upper.cols;
+  std::vector<int> lower_count(rows, 0);
+  for (std::size_t r = 0; r < rows; ++r)
+    for (int m = upper.start[r]; m < upper.start[r + 1]; ++m)
+      if (upper.column[static_cast<std::size_t>(m)] != static_cast<int>(r))
+        ++lower_count[static_cast<std::size_t>(upper.column[static_cast<std::size_t>(m)])];
+  S.start.assign(rows + 1, 0);
+  for (std::size_t k = 0; k < rows; ++k)
+    S.start[k + 1] = S.start[k] + lower_count[k] + (upper.start[k + 1] - upper.start[k]);
+  S.column.resize(static_cast<std::size_t>(S.start.back()));
+  S.block.resize(static_cast<std::size_t>(S.start.back()));
+  std::vector<int> fill(S.start.begin(), S.start.end() - 1);
+  for (std::size_t r = 0; r < rows; ++r)  // rows in order, so each lower part is sorted
+    for (int m = upper.start[r]; m < upper.start[r + 1]; ++m) {
+      const int c = upper.column[static_cast<std::size_t>(m)];
+      if (c == static_cast<int>(r)) continue;
+      const auto out = static_cast<std::size_t>(fill[static_cast<std::size_t>(c)]++);
+      S.column[out] = static_cast<int>(r);
+      S.block[out] = upper.block[static_cast<std::size_t>(m)].transpose();
+    }
+  parallel_rows(upper.rows, [&](int k) {
+    const auto row = static_cast<std::size_t>(k);
+    auto out = static_cast<std::size_t>(S.start[row] + lower_count[row]);
+    for (int m = upper.start[row]; m < upper.start[row + 1]; ++m, ++out) {
+      S.column[out] = upper.column[static_cast<std::size_t>(m)];
+      S.block[out] = upper.block[static_cast<std::size_t>(m)];
+    }
   });
+  return S;
 }
 
 void BlockSparseMatrix::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {

@@ -53,6 +53,10 @@ class BlockRowAccumulator {
 /// depend on the threads.
 BlockSparseMatrix build_block_rows(int rows, int cols, const std::function<void(int, BlockRowAccumulator&)>& body);
 
+/// The rows of `parts` one after the other, as one matrix of `cols` block columns; each part is
+/// freed once copied.
+BlockSparseMatrix stack_block_rows(std::vector<BlockSparseMatrix>&& parts, int cols);
+
 /// The symmetric matrix whose upper half (diagonal included) is `upper`'s; `upper` must hold
 /// no block below the diagonal.
 BlockSparseMatrix symmetric_from_upper(const BlockSparseMatrix& upper);
