@@ -38,25 +38,35 @@ std::string provenance_line(const ProvenanceRun& run) {
   return line;
 }
 
+namespace {
+
+// Takes `word` off the front of `line` if it is there.
+bool consume(std::string_view& line, std::string_view word) {
+  if (line.substr(0, word.size()) != word) return false;
+  line.remove_prefix(word.size());
+  return true;
+}
+
+}  // namespace
+
+// Only a line exactly as provenance_line writes it counts: any other comment that merely
+// mentions "--surface smooth" would make smooth mode hold a mesh no fit ever touched.
 bool records_fit(std::string_view comment) {
-  std::vector<std::string_view> words;
-  while (!comment.empty()) {
-    const std::size_t start = comment.find_first_not_of(' ');
-    if (start == std::string_view::npos) break;
-    comment.remove_prefix(start);
-    const std::size_t end = std::min(comment.find(' '), comment.size());
-    words.push_back(comment.substr(0, end));
-    comment.remove_prefix(end);
+  std::string_view rest = comment;
+  if (!consume(rest, "vertexflow enhance ")) return false;
+  if (!consume(rest, "--surface smooth")) {
+    // " --reference NAME --reference-method fit": NAME one word of printable characters.
+    if (!consume(rest, "--reference ")) return false;
+    const std::size_t name_end = rest.find(' ');
+    if (name_end == 0 || name_end == std::string_view::npos) return false;
+    for (const char c : rest.substr(0, name_end))
+      if (static_cast<unsigned char>(c) <= 32 || c == 127) return false;
+    rest.remove_prefix(name_end);
+    if (!consume(rest, " --reference-method fit")) return false;
   }
-  if (words.size() < 4 || words[0] != "vertexflow" || words[1] != "enhance") return false;
-  bool fit = false;
-  for (std::size_t i = 2; i < words.size(); ++i) {
-    if (words[i] == "(held:") return false;  // the vertices were left where they were
-    if (i + 1 < words.size() && ((words[i] == "--surface" && words[i + 1] == "smooth") ||
-                                 (words[i] == "--reference-method" && words[i + 1] == "fit")))
-      fit = true;
-  }
-  return fit;
+  consume(rest, " --assume-on-surface");
+  consume(rest, " --edge-flips");
+  return rest.empty();  // a " (held: ...)" line records no fit: the vertices stayed
 }
 
 const std::string* find_fit_provenance(const std::vector<std::string>& comments) {

@@ -204,6 +204,28 @@ TEST(Provenance, LinesAndWhichOfThemRecordAFit) {
   for (const char* other : {"", "vertexflow", "written by vertexflow", "made with --surface smooth",
                             "vertexflow enhance --surface", "vertexflow remesh --surface smooth"})
     EXPECT_FALSE(records_fit(other)) << other;
+  // Only a line exactly as provenance_line writes it (issue 32 item 13: any comment starting
+  // "vertexflow enhance --surface smooth" was trusted, and smooth mode then held the mesh).
+  for (const char* garbage :
+       {"vertexflow enhance --surface smooth <garbage>", "vertexflow enhance --surface smooth --edge-flips x",
+        "vertexflow enhance --surface input --surface smooth", "vertexflow enhance  --surface smooth",
+        "vertexflow enhance --surface smooth ", "vertexflow enhance --surface smoothly",
+        "vertexflow enhance --surface smooth --edge-flips --assume-on-surface",
+        "vertexflow enhance --reference a b --reference-method fit",
+        "vertexflow enhance --reference  --reference-method fit",
+        "vertexflow enhance --reference x.ply --reference-method fit --reference-method flow",
+        "vertexflow enhance --method unsharp --reference-method fit", "xvertexflow enhance --surface smooth"})
+    EXPECT_FALSE(records_fit(garbage)) << garbage;
+  for (const bool flips : {false, true})
+    for (const bool assume : {false, true})
+      for (const EnhanceMode mode : {EnhanceMode::Smooth, EnhanceMode::ReferenceFit}) {
+        ProvenanceRun written;
+        written.mode = mode;
+        written.reference = "dense.ply";
+        written.edge_flips = flips;
+        written.assume_on_surface = assume;
+        EXPECT_TRUE(records_fit(provenance_line(written))) << provenance_line(written);
+      }
   const std::vector<std::string> chain = {"scan", "vertexflow enhance --surface input",
                                           "vertexflow enhance --surface smooth", "vertexflow enhance --surface input"};
   ASSERT_NE(find_fit_provenance(chain), nullptr);
