@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cctype>
 #include <exception>
 #include <fstream>
 #include <map>
@@ -23,6 +24,16 @@
 
 namespace vertexflow {
 namespace {
+
+// Why std::filesystem::exists (or is_directory) said no, given its error code: "no such file or
+// directory" only when there is none; a loop of symbolic links, or a directory that may not be
+// searched, is named for what it is.
+std::string why_missing(const std::error_code& ec) {
+  if (!ec || ec == std::errc::no_such_file_or_directory) return "no such file or directory";
+  std::string message = ec.message();  // "Too many levels of symbolic links"
+  if (!message.empty()) message[0] = static_cast<char>(std::tolower(static_cast<unsigned char>(message[0])));
+  return message;
+}
 
 std::string join(const std::vector<std::string>& parts) {
   std::string s;
@@ -267,7 +278,7 @@ BatchRow enhance_file(const std::filesystem::path& input, const std::filesystem:
     if (!reference.empty()) {
       check_output_path(reference, output, /*force=*/false, /*mesh_output=*/true);
       if (!std::filesystem::exists(reference, ec))
-        throw IoError(reference.string() + ": no such file (the reference of " + input.string() + ")");
+        throw IoError(reference.string() + ": " + why_missing(ec) + " (the reference of " + input.string() + ")");
     }
     if (!options.force && std::filesystem::exists(output, ec)) {
       row.status = "skipped";
@@ -414,7 +425,7 @@ std::vector<std::filesystem::path> batch_inputs(const std::vector<std::string>& 
       if (matched.empty()) throw IoError(spec + ": matches no mesh file");
       files.insert(files.end(), matched.begin(), matched.end());
     } else {
-      if (!std::filesystem::exists(spec, ec)) throw IoError(spec + ": no such file or directory");
+      if (!std::filesystem::exists(spec, ec)) throw IoError(spec + ": " + why_missing(ec));
       files.emplace_back(spec);
     }
   }
@@ -434,8 +445,9 @@ std::string mesh_stem(const std::filesystem::path& path) {
 std::map<std::string, std::filesystem::path> references_by_stem(const std::filesystem::path& directory) {
   std::error_code ec;
   std::vector<std::filesystem::path> meshes;
+  std::error_code entry_ec;  // an entry that cannot be looked at (a link loop) is no reference
   for (const auto& entry : std::filesystem::directory_iterator(directory, ec))
-    if (entry.is_regular_file(ec) && is_mesh_path(entry.path())) meshes.push_back(entry.path());
+    if (entry.is_regular_file(entry_ec) && is_mesh_path(entry.path())) meshes.push_back(entry.path());
   if (ec) throw IoError(directory.string() + ": cannot list the reference directory: " + ec.message());
   std::sort(meshes.begin(), meshes.end());
   std::map<std::string, std::filesystem::path> by_stem;
@@ -451,7 +463,8 @@ std::vector<BatchItem> batch_items(const BatchOptions& options) {
     for (const std::filesystem::path& file : batch_inputs(options.inputs)) items.push_back({file, {}, {}});
   std::error_code ec;
   if (!options.reference_dir.empty() && !std::filesystem::is_directory(options.reference_dir, ec))
-    throw IoError(options.reference_dir.string() + ": is not a directory (the reference directory)");
+    throw IoError(options.reference_dir.string() + ": " + (ec ? why_missing(ec) : std::string("is not a directory")) +
+                  " (the reference directory)");
   const std::map<std::string, std::filesystem::path> references = options.reference_dir.empty()
                                                                       ? std::map<std::string, std::filesystem::path>{}
                                                                       : references_by_stem(options.reference_dir);

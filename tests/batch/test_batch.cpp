@@ -2,7 +2,7 @@
 // directory, outputs bit for bit those of `vertexflow enhance`, summaries with each file's mode
 // and distances, a directory's own summaries never taken for inputs, a damaged summary named and
 // its rows measured again, hostile directory entries failing alike in directory and glob mode,
-// and a progress callback that throws stopping the batch.
+// a loop of symbolic links named as one, and a progress callback that throws stopping the batch.
 #include "shapes.h"
 #include "test_support.h"
 
@@ -333,6 +333,48 @@ TEST(Batch, HostileEntriesAreFailedRowsInDirectoryAndGlobModeAlike) {
   EXPECT_EQ(rows[0], expected) << rows[0].dump(1);
   EXPECT_EQ(rows[1], expected) << rows[1].dump(1);
   EXPECT_EQ(rows[2], expected) << rows[2].dump(1);
+}
+
+// Issue 32 item 13: a loop of symbolic links is named for what it is, not "no such file or
+// directory": as the input, as the reference directory, and as a directory's entry; a looped entry
+// of the reference directory is no reference but does not stop the listing.
+TEST(Batch, ASymlinkLoopIsNamedAsOne) {
+  test::ScratchDir dir("batch-loop");
+  const auto loop = dir.file("loop.obj"), loop_dir = dir.file("loop_dir");
+  std::filesystem::create_symlink(loop.filename(), loop);
+  std::filesystem::create_symlink(loop_dir.filename(), loop_dir);
+  const auto in = dir.file("in"), references = dir.file("references");
+  std::filesystem::create_directories(in);
+  std::filesystem::create_directories(references);
+  write_mesh(in / "good.obj", test::icosphere(1.0, 1));
+  std::filesystem::create_symlink("looped.obj", in / "looped.obj");
+  write_mesh(references / "good.ply", test::icosphere(1.0, 2));
+  std::filesystem::create_symlink("other.obj", references / "other.obj");
+  const std::string looping = "too many levels of symbolic links";
+  for (const auto& spec : {loop, loop_dir}) {
+    const auto r = test::run_cli("--quiet batch " + test::quoted(spec) + " " + test::quoted(dir.file("out")));
+    EXPECT_EQ(r.exit_code, 1) << r.err;
+    EXPECT_EQ(r.err, "vertexflow: error: " + spec.string() + ": " + looping + "\n");
+  }
+  const auto reference_dir = test::run_cli("--quiet batch " + test::quoted(in) + " " + test::quoted(dir.file("out")) +
+                                           " --reference-dir " + test::quoted(loop_dir));
+  EXPECT_EQ(reference_dir.err,
+            "vertexflow: error: " + loop_dir.string() + ": " + looping + " (the reference directory)\n");
+  const auto out = dir.file("out");
+  const auto r = test::run_cli("--quiet batch " + test::quoted(in) + " " + test::quoted(out) + " --reference-dir " +
+                               test::quoted(references));
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("1 of 2 files failed"), std::string::npos) << r.err;
+  const auto rows = summary_rows(out);
+  ASSERT_EQ(rows.size(), 2u);
+  EXPECT_EQ(rows[0]["status"], "done");
+  EXPECT_EQ(rows[1]["status"], "failed");
+  // Without references, the looped entry's row says why it failed.
+  const auto plain_out = dir.file("plain");
+  test::run_cli("--quiet batch " + test::quoted(in) + " " + test::quoted(plain_out));
+  const auto plain = summary_rows(plain_out);
+  ASSERT_EQ(plain.size(), 2u);
+  EXPECT_EQ(plain[1]["error"], (in / "looped.obj").string() + ": cannot open: Too many levels of symbolic links");
 }
 
 // Issue 32 item 7, in the engine: a progress callback that throws stops the batch at the next file
