@@ -484,6 +484,26 @@ std::optional<MeshFormat> format_from_content(std::string_view head, std::string
   return std::nullopt;
 }
 
+// Whether `head` has a NUL byte outside OBJ '#' comments: binary data, not an OBJ file. A comment
+// may hold anything up to its line's end (or, ending in a backslash, the next line's, as
+// parse_obj reads it), so a NUL written there by some tool does not reject the file.
+bool nul_outside_obj_comments(std::string_view head) {
+  for (std::size_t p = 0; p < head.size(); ++p) {
+    if (head[p] == '\0') return true;
+    if (head[p] != '#') continue;
+    for (std::size_t line = p;;) {  // skip the comment, continued lines included
+      const std::size_t nl = head.find('\n', line);
+      if (nl == std::string_view::npos) return false;
+      std::size_t end = nl;
+      while (end > line && (head[end - 1] == ' ' || head[end - 1] == '\t' || head[end - 1] == '\r')) --end;
+      p = nl;
+      if (end == line || head[end - 1] != '\\') break;
+      line = nl + 1;
+    }
+  }
+  return false;
+}
+
 Mesh read_mesh_checked(std::string_view bytes, MeshFormat format, const std::string& name, ReadReport& r,
                        const ReadOptions& options) {
   r = ReadReport{};
@@ -502,7 +522,7 @@ Mesh read_mesh_checked(std::string_view bytes, MeshFormat format, const std::str
     if (content && *content != format) {
       r.format = *content;
       r.format_differs_from_extension = true;
-    } else if (!content && format == MeshFormat::Obj && head.find('\0') != std::string_view::npos) {
+    } else if (!content && format == MeshFormat::Obj && nul_outside_obj_comments(head)) {
       io_detail::fail(name, "not an OBJ file (it holds binary data, and OBJ is text)");
     }
     switch (r.format) {

@@ -157,3 +157,42 @@ TEST(WriteComments, ControlCharactersCannotBreakTheFile) {
 
 }  // namespace
 }  // namespace vertexflow
+
+namespace vertexflow {
+namespace {
+
+// A '#' comment may hold anything up to its line's end, a NUL byte included (issue 32 item 13:
+// one in the first 4 KiB rejected the whole file as "binary data"); a NUL outside comments is
+// still binary data.
+TEST(ReadComments, ANulByteInAnObjCommentIsText) {
+  test::ScratchDir dir("comments-nul");
+  const std::string body = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  const std::string nul(1, '\0');
+  const struct {
+    const char* name;
+    std::string text;
+  } cases[] = {{"first_line", "# made by" + nul + "tool\n" + body},
+               {"inline", "v 0 0 0 # c" + nul + "\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"},
+               {"continued", "# a \\\n b" + nul + "\n" + body}};
+  for (const auto& c : cases) {
+    const auto path = dir.file(std::string(c.name) + ".obj");
+    write_bytes(path, c.text);
+    Mesh mesh;
+    ASSERT_NO_THROW(mesh = read_mesh(path)) << c.name;
+    EXPECT_EQ(mesh.V.rows(), 3) << c.name;
+    EXPECT_EQ(mesh.F.rows(), 1) << c.name;
+  }
+  EXPECT_EQ(read_mesh(dir.file("first_line.obj")).comments, std::vector<std::string>{"made by?tool"});
+  for (const std::string& binary : {"v 0 0" + nul + " 0\n" + body, "# comment\n" + nul + body}) {
+    write_bytes(dir.file("binary.obj"), binary);
+    try {
+      read_mesh(dir.file("binary.obj"));
+      ADD_FAILURE() << "read binary data as OBJ";
+    } catch (const IoError& e) {
+      EXPECT_NE(std::string(e.what()).find("it holds binary data"), std::string::npos) << e.what();
+    }
+  }
+}
+
+}  // namespace
+}  // namespace vertexflow
