@@ -3,8 +3,11 @@
 
 #include "vertexflow/io.h"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <initializer_list>
+#include <optional>
 
 namespace vertexflow::python {
 
@@ -34,8 +37,45 @@ DoubleArray as_vertices(const py::handle& object, const char* name) {
   return v;
 }
 
+namespace {
+
+// The first entry of `a` (integers, or floats already known to be whole) outside [low, high):
+// the value as given, as text, and its flat position. Checked in the array's own dtype before
+// any cast to int64, which would wrap a uint64 above 2^63 - 1 (2^64 - 1 read as -1) and make a
+// float beyond int64 any value at all.
+std::optional<std::pair<std::string, py::ssize_t>> first_outside(const py::array& a, std::int64_t low,
+                                                                 std::int64_t high) {
+  const char kind = a.dtype().kind();
+  if (kind == 'u') {
+    const auto u = py::array_t<std::uint64_t, py::array::c_style | py::array::forcecast>::ensure(a);
+    if (!u) throw py::error_already_set();
+    for (py::ssize_t i = 0; i < u.size(); ++i)
+      if (static_cast<std::int64_t>(std::min<std::uint64_t>(u.data()[i], INT64_MAX)) < low ||
+          u.data()[i] >= static_cast<std::uint64_t>(std::max<std::int64_t>(high, 0)))
+        return std::make_pair(std::to_string(u.data()[i]), i);
+  } else if (kind == 'f') {
+    const DoubleArray d = DoubleArray::ensure(a);
+    if (!d) throw py::error_already_set();
+    for (py::ssize_t i = 0; i < d.size(); ++i)
+      if (!(d.data()[i] >= static_cast<double>(low) && d.data()[i] < static_cast<double>(high)))
+        return std::make_pair(py::repr(py::float_(d.data()[i])).cast<std::string>(), i);
+  } else {
+    const Int64Array v = Int64Array::ensure(a);
+    if (!v) throw py::error_already_set();
+    for (py::ssize_t i = 0; i < v.size(); ++i)
+      if (v.data()[i] < low || v.data()[i] >= high) return std::make_pair(std::to_string(v.data()[i]), i);
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
 Int64Array as_faces(const py::handle& object, py::ssize_t num_vertices, const char* name) {
   py::array a = as_numeric_array(object, name);
+  if (a.ndim() != 2 || a.shape(1) != 3)
+    throw py::value_error(std::string(name) + " must have shape (m, 3) (triangles), got " +
+                          std::string(py::str(py::getattr(a, "shape"))));
+  if (a.shape(0) == 0) throw py::value_error(std::string(name) + " is empty (no faces)");
   if (a.dtype().kind() == 'f') {
     const DoubleArray d = DoubleArray::ensure(a);
     for (py::ssize_t i = 0; i < d.size(); ++i)
@@ -43,17 +83,11 @@ Int64Array as_faces(const py::handle& object, py::ssize_t num_vertices, const ch
         throw py::value_error(std::string(name) + " must hold vertex indices (integers), got " +
                               std::to_string(d.data()[i]));
   }
+  if (const auto bad = first_outside(a, 0, num_vertices))
+    throw py::value_error(std::string(name) + " has vertex index " + bad->first + " (row " +
+                          std::to_string(bad->second / 3) + ") outside [0, " + std::to_string(num_vertices) + ")");
   Int64Array f = Int64Array::ensure(a);
   if (!f) throw py::error_already_set();
-  if (f.ndim() != 2 || f.shape(1) != 3)
-    throw py::value_error(std::string(name) + " must have shape (m, 3) (triangles), got " +
-                          std::string(py::str(py::getattr(f, "shape"))));
-  if (f.shape(0) == 0) throw py::value_error(std::string(name) + " is empty (no faces)");
-  const std::int64_t* data = f.data();
-  for (py::ssize_t i = 0; i < f.size(); ++i)
-    if (data[i] < 0 || data[i] >= num_vertices)
-      throw py::value_error(std::string(name) + " has vertex index " + std::to_string(data[i]) + " (row " +
-                            std::to_string(i / 3) + ") outside [0, " + std::to_string(num_vertices) + ")");
   return f;
 }
 
@@ -216,17 +250,16 @@ CornerChannel corner_from_python(const py::handle& object, const std::string& na
       if (f.data()[i] != std::floor(f.data()[i]))
         throw py::value_error(corners_name + " must hold row indices (integers), got " + std::to_string(f.data()[i]));
   }
+  if (a.ndim() != 2 || a.shape(1) != 3 || a.shape(0) != num_faces)
+    throw py::value_error(corners_name + " must have shape (" + std::to_string(num_faces) +
+                          ", 3) (one row per face), got " + std::string(py::str(py::getattr(a, "shape"))));
+  const std::int64_t rows = c.channel.rows();
+  // In the array's own dtype: a uint64 2^64 - 1 cast to int64 would read as -1, "none".
+  if (const auto bad = first_outside(a, -1, rows))
+    throw py::value_error(corners_name + " has " + bad->first + " (row " + std::to_string(bad->second / 3) +
+                          ") outside -1.." + std::to_string(rows - 1) + " (the rows of its values; -1: none)");
   const Int64Array corners = Int64Array::ensure(a);
   if (!corners) throw py::error_already_set();
-  if (corners.ndim() != 2 || corners.shape(1) != 3 || corners.shape(0) != num_faces)
-    throw py::value_error(corners_name + " must have shape (" + std::to_string(num_faces) +
-                          ", 3) (one row per face), got " + std::string(py::str(py::getattr(corners, "shape"))));
-  const std::int64_t rows = c.channel.rows();
-  for (py::ssize_t i = 0; i < corners.size(); ++i)
-    if (corners.data()[i] < -1 || corners.data()[i] >= rows)
-      throw py::value_error(corners_name + " has " + std::to_string(corners.data()[i]) + " (row " +
-                            std::to_string(i / 3) + ") outside -1.." + std::to_string(rows - 1) +
-                            " (the rows of its values; -1: none)");
   c.corners = Eigen::Map<const Eigen::Matrix<std::int64_t, Eigen::Dynamic, 3, Eigen::RowMajor>>(corners.data(),
                                                                                                 corners.shape(0), 3)
                   .cast<std::int32_t>();

@@ -1,5 +1,6 @@
 """The module's API on numpy arrays: identity with the CLI, round trips, errors, copies, the GIL."""
 
+import re
 import threading
 import time
 
@@ -189,6 +190,31 @@ def test_bad_arrays_raise_value_error():
         for call in (vertexflow.enhance, vertexflow.principal_curvatures):
             with pytest.raises(ValueError, match=word):
                 call(V_bad, F_bad)
+
+
+def test_an_index_out_of_range_is_reported_as_given():
+    """Issue 32 item 12: a uint64 F holding 2^64 - 1 was reported as "vertex index -1" (the value
+    cast to int64), and a float index beyond int64 as whatever the cast made of it."""
+    V, F = read("spot.obj")
+    for dtype, value, text in [(np.uint64, 2**64 - 1, "18446744073709551615"),
+                               (np.uint64, 2**63, "9223372036854775808"),
+                               (np.uint32, 2**32 - 1, "4294967295"),
+                               (np.float64, 1e20, "1e+20"),
+                               (np.int64, -2**63, str(-2**63))]:
+        F_bad = F.astype(dtype)
+        F_bad[3, 1] = value
+        for call in (vertexflow.enhance, vertexflow.principal_curvatures):
+            with pytest.raises(ValueError, match=re.escape(f"has vertex index {text} (row 3) outside [0, {len(V)})")):
+                call(V, F_bad)
+    # The same for a corner channel's rows, where -1 means "none": 2^64 - 1 is not -1.
+    V_tet = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1]], dtype=float)
+    F_tet = np.array([[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]])
+    corners = np.zeros((4, 3), dtype=np.uint64)
+    corners[2, 0] = 2**64 - 1
+    uv = {"name": "uv", "type": "float32", "role": "texcoord", "values": np.zeros((3, 2)), "components": ["s", "t"],
+          "corners": corners}
+    with pytest.raises(ValueError, match=re.escape("has 18446744073709551615 (row 2) outside -1..2")):
+        vertexflow.enhance(V_tet, F_tet, attributes={"corner": [uv]})
 
 
 def test_bad_options_raise():
