@@ -7,6 +7,7 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
 #include <set>
 
 namespace vertexflow::cli {
@@ -158,6 +159,16 @@ void register_compare_lines_command(CLI::App& app, const GlobalOptions& global) 
     apply_line_options(o->lines, o->fidelity.drawing);
     const Mesh coarse = read_mesh_with_warnings(o->coarse, global);
     const Mesh dense = read_mesh_with_warnings(o->dense, global);
+    // Both are drawn in the dense mesh's frame: a coarse mesh elsewhere draws nothing there, and
+    // its F1 of 0 says where it is, not how its lines compare.
+    const BoundingBox coarse_box = bounding_box(coarse.V), dense_box = bounding_box(dense.V);
+    if (((coarse_box.max.array() < dense_box.min.array()).any() ||
+         (dense_box.max.array() < coarse_box.min.array()).any()) &&
+        !global.quiet)
+      fmt::print(stderr,
+                 "vertexflow: warning: {} and {}: the bounding boxes do not overlap, so the drawings cannot match "
+                 "(both are framed on {})\n",
+                 o->coarse, o->dense, o->dense);
     LineFidelity fidelity;
     try {
       fidelity = line_drawing_fidelity(coarse, dense, o->fidelity);
@@ -186,12 +197,16 @@ void register_compare_lines_command(CLI::App& app, const GlobalOptions& global) 
                              .dump(2));
       return;
     }
-    fmt::print("{:>8} {:>10} {:>8} {:>6} {:>13} {:>12}\n", "azimuth", "precision", "recall", "F1", "coarse pixels",
+    // Undefined (NaN: neither drawing has a line pixel) reads "no lines" (JSON: null).
+    const auto number = [](double x) { return std::isnan(x) ? std::string("-") : fmt::format("{:.3f}", x); };
+    const auto f1 = [](double x) { return std::isnan(x) ? std::string("no lines") : fmt::format("{:.3f}", x); };
+    fmt::print("{:>8} {:>10} {:>8} {:>8} {:>13} {:>12}\n", "azimuth", "precision", "recall", "F1", "coarse pixels",
                "dense pixels");
     for (const LineFidelityView& v : fidelity.views)
-      fmt::print("{:>8.1f} {:>10.3f} {:>8.3f} {:>6.3f} {:>13} {:>12}\n", v.azimuth_degrees, v.precision, v.recall, v.f1,
-                 v.coarse_pixels, v.dense_pixels);
-    fmt::print("{:>8} {:>10.3f} {:>8.3f} {:>6.3f}\n", "mean", fidelity.precision, fidelity.recall, fidelity.f1);
+      fmt::print("{:>8.1f} {:>10} {:>8} {:>8} {:>13} {:>12}\n", v.azimuth_degrees, number(v.precision),
+                 number(v.recall), f1(v.f1), v.coarse_pixels, v.dense_pixels);
+    fmt::print("{:>8} {:>10} {:>8} {:>8}\n", "mean", number(fidelity.precision), number(fidelity.recall),
+               f1(fidelity.f1));
   });
 }
 

@@ -91,8 +91,10 @@ inline LineDrawingOptions default_fidelity_drawing() {
 /// azimuths evenly spaced around +y at `elevation_degrees`. Per view, precision is the share of
 /// the coarse drawing's line pixels within `match_pixels` of a dense line pixel, recall the
 /// share of the dense drawing's line pixels within `match_pixels` of a coarse one, and F1
-/// their harmonic mean (0 when both are 0); a view where a drawing has no line pixel counts
-/// precision or recall as 0.
+/// their harmonic mean (0 when both are 0); a view where one drawing has no line pixel counts
+/// precision or recall as 0. A view where neither has one has no precision, recall or F1 (NaN:
+/// undefined, e.g. a flat mesh against itself) and is left out of the means, which are NaN when
+/// no view has lines.
 struct LineFidelityOptions {
   int views = 8;                  ///< >= 1
   double elevation_degrees = 15;  ///< in [-90, 90]
@@ -103,13 +105,13 @@ struct LineFidelityOptions {
 
 struct LineFidelityView {
   double azimuth_degrees = 0;
-  double precision = 0, recall = 0, f1 = 0;
+  double precision = 0, recall = 0, f1 = 0;  ///< NaN when neither drawing has a line pixel
   Index coarse_pixels = 0, dense_pixels = 0;
 };
 
 struct LineFidelity {
   std::vector<LineFidelityView> views;
-  double precision = 0, recall = 0, f1 = 0;  ///< means over the views
+  double precision = 0, recall = 0, f1 = 0;  ///< means over the views with lines (NaN: none has)
 };
 
 /// Throws std::invalid_argument for options out of range or an empty mesh.

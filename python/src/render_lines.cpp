@@ -8,6 +8,7 @@
 
 #include <pybind11/stl.h>
 
+#include <cmath>
 #include <cstring>
 
 namespace vertexflow::python {
@@ -152,14 +153,26 @@ py::dict py_compare_lines(const py::handle& Vc, const py::handle& Fc, const py::
   options.width = width;
   options.height = height;
   options.match_pixels = match_pixels;
+  const BoundingBox coarse_box = bounding_box(coarse.V), dense_box = bounding_box(dense.V);
+  if ((coarse_box.max.array() < dense_box.min.array()).any() || (dense_box.max.array() < coarse_box.min.array()).any())
+    if (PyErr_WarnEx(PyExc_UserWarning,
+                     "compare_lines: the bounding boxes do not overlap, so the drawings cannot match (both are "
+                     "framed on the dense mesh)",
+                     1) != 0)
+      throw py::error_already_set();
   const LineFidelity fidelity = without_gil(threads, [&] { return line_drawing_fidelity(coarse, dense, options); });
+  // Undefined (neither drawing has a line pixel) is None, as the CLI's JSON has null.
+  const auto value = [](double x) -> py::object {
+    if (std::isnan(x)) return py::none();
+    return py::float_(x);
+  };
   py::list per_view;
   for (const LineFidelityView& v : fidelity.views)
-    per_view.append(py::dict(py::arg("azimuth") = v.azimuth_degrees, py::arg("precision") = v.precision,
-                             py::arg("recall") = v.recall, py::arg("f1") = v.f1,
+    per_view.append(py::dict(py::arg("azimuth") = v.azimuth_degrees, py::arg("precision") = value(v.precision),
+                             py::arg("recall") = value(v.recall), py::arg("f1") = value(v.f1),
                              py::arg("coarse_pixels") = v.coarse_pixels, py::arg("dense_pixels") = v.dense_pixels));
-  return py::dict(py::arg("precision") = fidelity.precision, py::arg("recall") = fidelity.recall,
-                  py::arg("f1") = fidelity.f1, py::arg("views") = per_view);
+  return py::dict(py::arg("precision") = value(fidelity.precision), py::arg("recall") = value(fidelity.recall),
+                  py::arg("f1") = value(fidelity.f1), py::arg("views") = per_view);
 }
 
 }  // namespace
@@ -200,7 +213,8 @@ bounding-box diagonal). Hidden lines are not removed: line_drawing does that.)do
         py::arg("height") = LineFidelityOptions{}.height, py::arg("match_pixels") = LineFidelityOptions{}.match_pixels,
         py::arg("threads") = 0,
         R"doc(`vertexflow compare-lines`: line-drawing fidelity of the coarse mesh against the dense one
-(line_drawing.h) -> {"precision", "recall", "f1", "views": [per view]}.)doc");
+(line_drawing.h) -> {"precision", "recall", "f1", "views": [per view]}; each None where neither drawing has a
+line pixel (a flat mesh), and a UserWarning when the two bounding boxes do not overlap.)doc");
 }
 
 }  // namespace vertexflow::python

@@ -324,6 +324,20 @@ def test_feature_lines_line_drawing_and_compare_lines():
     assert vertexflow.compare_lines(moved, F, V, F, views=6, width=200, height=150)["f1"] < 0.6
 
 
+def test_compare_lines_without_lines_is_none_and_meshes_apart_warn():
+    """Issue 32 item 8: a triangle against itself draws no lines: F1 is undefined (None), not 0;
+    and meshes whose boxes do not overlap give a warning with their F1 of 0."""
+    V = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], dtype=float)
+    F = np.array([[0, 1, 2]])
+    result = vertexflow.compare_lines(V, F, V, F, views=2, width=64, height=48)
+    assert result["f1"] is None and result["precision"] is None and result["recall"] is None
+    assert all(view["f1"] is None and view["coarse_pixels"] == 0 for view in result["views"])
+    S, G = read("sphere.off")
+    with pytest.warns(UserWarning, match="bounding boxes do not overlap"):
+        apart = vertexflow.compare_lines(S + np.array([1e6, 0, 0]), G, S, G, views=2, width=64, height=48)
+    assert apart["f1"] == 0.0
+
+
 def test_gil_is_released_during_enhance():
     # The progress callback is called just before the C++ work and just after it. Released, the
     # GIL lets this thread run at once; held, this thread gets it back only when the call ends.

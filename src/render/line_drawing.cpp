@@ -13,6 +13,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 
@@ -270,6 +271,7 @@ LineFidelity line_drawing_fidelity(const Mesh& coarse, const Mesh& dense, const 
   drawing.render.elevation_degrees = options.elevation_degrees;
   if (drawing.lines.length_scale == 0) drawing.lines.length_scale = dense_box.diagonal();
   LineFidelity result;
+  int with_lines = 0;  // views where either drawing has a line pixel: the means' count
   for (int v = 0; v < options.views; ++v) {
     drawing.render.azimuth_degrees = 360.0 * v / options.views;
     const std::vector<char> a = line_pixels(draw_lines(coarse, drawing));
@@ -278,16 +280,28 @@ LineFidelity line_drawing_fidelity(const Mesh& coarse, const Mesh& dense, const 
     view.azimuth_degrees = drawing.render.azimuth_degrees;
     view.precision = matched_share(a, b, options.width, options.height, options.match_pixels, view.coarse_pixels);
     view.recall = matched_share(b, a, options.width, options.height, options.match_pixels, view.dense_pixels);
+    if (view.coarse_pixels == 0 && view.dense_pixels == 0) {
+      // Nothing drawn on either side: no agreement to measure (a flat mesh, one triangle), not
+      // a score of 0 for a mesh against itself.
+      view.precision = view.recall = view.f1 = std::numeric_limits<double>::quiet_NaN();
+      result.views.push_back(view);
+      continue;
+    }
     const double sum = view.precision + view.recall;
     view.f1 = sum > 0 ? 2 * view.precision * view.recall / sum : 0.0;
     result.precision += view.precision;  // sums here, means after the loop
     result.recall += view.recall;
     result.f1 += view.f1;
+    ++with_lines;
     result.views.push_back(view);
   }
-  result.precision /= options.views;
-  result.recall /= options.views;
-  result.f1 /= options.views;
+  if (with_lines == 0) {
+    result.precision = result.recall = result.f1 = std::numeric_limits<double>::quiet_NaN();
+  } else {
+    result.precision /= with_lines;
+    result.recall /= with_lines;
+    result.f1 /= with_lines;
+  }
   return result;
 }
 

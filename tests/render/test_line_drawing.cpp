@@ -9,8 +9,10 @@
 #include "vertexflow/line_drawing.h"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <fstream>
 #include <iostream>
 #include <numbers>
 #include <regex>
@@ -170,6 +172,35 @@ TEST(LineFidelity, SelfIsPerfectACoarseSphereIsCloseAMovedCopyIsNot) {
   EXPECT_THROW(line_drawing_fidelity(dense, dense, o), std::invalid_argument);
 }
 
+// Issue 32 item 8: where neither drawing has a line pixel (a flat mesh, one triangle) there is
+// nothing to agree on: F1 is undefined (NaN), not 0 for a mesh against itself, and such views are
+// left out of the means.
+TEST(LineFidelity, NoLinesOnEitherSideIsUndefinedNotZero) {
+  Mesh triangle;
+  triangle.V = (Vertices(3, 3) << 0, 0, 0, 1, 0, 0, 0, 1, 0).finished();
+  triangle.F = (Faces(1, 3) << 0, 1, 2).finished();
+  LineFidelityOptions o;
+  o.views = 4;
+  o.width = 64;
+  o.height = 48;
+  for (const Mesh& mesh : {triangle, test::height_field(1.0, 10, [](double, double) { return 0.0; })}) {
+    const LineFidelity self = line_drawing_fidelity(mesh, mesh, o);
+    EXPECT_TRUE(std::isnan(self.f1)) << self.f1;
+    EXPECT_TRUE(std::isnan(self.precision) && std::isnan(self.recall));
+    ASSERT_EQ(self.views.size(), 4u);
+    for (const LineFidelityView& v : self.views) {
+      EXPECT_EQ(v.coarse_pixels + v.dense_pixels, 0);
+      EXPECT_TRUE(std::isnan(v.f1));
+    }
+  }
+  // A drawing with lines against an empty one still scores 0.
+  const Mesh sphere = test::icosphere(1.0, 3);
+  Mesh far = sphere;
+  far.V.col(0).array() += 1e6;
+  const LineFidelity apart = line_drawing_fidelity(far, sphere, o);
+  EXPECT_EQ(apart.f1, 0.0);
+}
+
 // ---- CLI -----------------------------------------------------------------------------------
 
 TEST(LinesCli, WritesSvgAndPngAndRefusesBadOutput) {
@@ -210,7 +241,40 @@ TEST(LinesCli, CompareLinesPrintsF1) {
   EXPECT_LT(f1, 0.95);
   const test::CommandResult self = test::run_cli("compare-lines " + dense + " " + dense + " --views 6 --size 200x150");
   ASSERT_EQ(self.exit_code, 0) << self.err;
-  EXPECT_NE(self.out.find("mean      1.000    1.000  1.000"), std::string::npos) << self.out;
+  EXPECT_NE(self.out.find("mean      1.000    1.000    1.000"), std::string::npos) << self.out;
+}
+
+// Issue 32 item 8 at the command line: undefined F1 is null in JSON and "no lines" in the table,
+// and meshes whose boxes do not overlap are warned about (F1 0 says where they are, not how their
+// lines compare).
+TEST(LinesCli, CompareLinesSaysNoLinesAndWarnsAboutMeshesApart) {
+  test::ScratchDir dir("compare_lines_cli");
+  const auto triangle = dir.file("triangle.obj"), tet = dir.file("tet.obj"), far = dir.file("far.obj");
+  std::ofstream(triangle) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+  const std::string faces = "f 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  std::ofstream(tet) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n" << faces;
+  std::ofstream(far) << "v 1000000 0 0\nv 1000001 0 0\nv 1000000 1 0\nv 1000000 0 1\n" << faces;
+  const std::string options = " --views 2 --size 64x48";
+  const auto json =
+      test::run_cli("compare-lines " + test::quoted(triangle) + " " + test::quoted(triangle) + options + " --json");
+  ASSERT_EQ(json.exit_code, 0) << json.err;
+  const auto j = nlohmann::json::parse(json.out);
+  EXPECT_TRUE(j["f1"].is_null()) << json.out;
+  EXPECT_TRUE(j["precision"].is_null() && j["recall"].is_null()) << json.out;
+  EXPECT_TRUE(j["views"][0]["f1"].is_null()) << json.out;
+  const auto text = test::run_cli("compare-lines " + test::quoted(triangle) + " " + test::quoted(triangle) + options);
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("    mean          -        - no lines"), std::string::npos) << text.out;
+  EXPECT_EQ(text.err, "");
+  const auto apart = test::run_cli("compare-lines " + test::quoted(far) + " " + test::quoted(tet) + options);
+  EXPECT_EQ(apart.exit_code, 0) << apart.err;
+  EXPECT_EQ(apart.err, "vertexflow: warning: " + far.string() + " and " + tet.string() +
+                           ": the bounding boxes do not overlap, so the drawings cannot match (both are framed on " +
+                           tet.string() + ")\n");
+  EXPECT_NE(apart.out.find("    mean      0.000    0.000    0.000"), std::string::npos) << apart.out;
+  const auto same = test::run_cli("compare-lines " + test::quoted(tet) + " " + test::quoted(tet) + options);
+  EXPECT_EQ(same.err, "");
+  EXPECT_NE(same.out.find("    mean      1.000    1.000    1.000"), std::string::npos) << same.out;
 }
 
 }  // namespace
