@@ -25,7 +25,7 @@ AggregationCoarseSpace::AggregationCoarseSpace(const std::vector<Index>& start, 
   for (std::size_t i = 0; i < n; ++i)
     basis_start_[i + 1] = basis_start_[i] + 1 + static_cast<std::size_t>(start[i + 1] - start[i]);
   basis_.resize(basis_start_[n]);
-  basis_size_.assign(n, 0);
+  std::vector<std::size_t> basis_size(n, 0);
   parallel_for_index(n_, [&](Index i) {
     const auto v = static_cast<std::size_t>(i);
     if (fixed[v]) return;
@@ -47,8 +47,21 @@ AggregationCoarseSpace::AggregationCoarseSpace(const std::vector<Index>& start, 
       if (aggregate[j] >= 0) add(aggregate[j], w);
     }
     std::sort(out, out + size, [](const Weight& x, const Weight& y) { return x.aggregate < y.aggregate; });
-    basis_size_[v] = size;
+    basis_size[v] = size;
   });
+  // Packed: each vertex was given room for its whole one-ring, about twice what its basis
+  // functions take (kept through the set-up and the solve).
+  std::size_t packed = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    if (packed != basis_start_[i])  // packed < start: a forward copy is safe
+      std::copy_n(basis_.begin() + static_cast<std::ptrdiff_t>(basis_start_[i]), basis_size[i],
+                  basis_.begin() + static_cast<std::ptrdiff_t>(packed));
+    basis_start_[i] = packed;
+    packed += basis_size[i];
+  }
+  basis_start_[n] = packed;
+  basis_.resize(packed);
+  basis_.shrink_to_fit();
   const auto na = static_cast<std::size_t>(count_);
   member_start_.assign(na + 1, 0);
   for (std::size_t i = 0; i < n; ++i)

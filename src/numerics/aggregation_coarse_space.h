@@ -42,7 +42,7 @@ class AggregationCoarseSpace {
   /// chi_a on free vertices, W the one-ring average, chi_a the indicator of aggregate a.
   [[nodiscard]] std::span<const Weight> basis(Index i) const {
     const auto v = static_cast<std::size_t>(i);
-    return {basis_.data() + basis_start_[v], basis_size_[v]};
+    return {basis_.data() + basis_start_[v], basis_start_[v + 1] - basis_start_[v]};
   }
   /// coarse = Phi^T r (3 per aggregate).
   void restrict_to(const BlockVector& r, BlockVector& coarse) const;
@@ -50,7 +50,7 @@ class AggregationCoarseSpace {
  private:
   Index n_ = 0;
   int count_ = 0;
-  std::vector<std::size_t> basis_start_, basis_size_, member_start_;
+  std::vector<std::size_t> basis_start_, member_start_;
   std::vector<Weight> basis_;    // per vertex: (aggregate, phi_a(i))
   std::vector<Weight> members_;  // per aggregate: (vertex, phi_a(i))
 };

@@ -284,6 +284,61 @@ std::vector<int> aggregate_nodes(const std::vector<int>& start, const std::vecto
   return aggregate;
 }
 
+namespace {
+
+// The Galerkin matrix R (A P), a range of its rows at a time from the rows of A P that range
+// needs only: A P whole was as large as A, and beside A, P and R the peak of the hierarchy's
+// set-up. Each row of A P and each block of the product is summed in the order of the whole
+// product, so the result is the same.
+BlockSparseMatrix galerkin_product(const BlockSparseMatrix& A, const BlockSparseMatrix& P, const BlockSparseMatrix& R) {
+  constexpr int kRangeRows = 8192;
+  const int count = R.rows;
+  std::vector<int> slot(static_cast<std::size_t>(A.rows), -1);  // row of A P -> its place in `ap`
+  std::vector<int> needed;
+  std::vector<std::vector<std::pair<int, Matrix3>>> ap;
+  tbb::enumerable_thread_specific<BlockRowAccumulator> accumulators([&] { return BlockRowAccumulator(P.cols); });
+  std::vector<BlockSparseMatrix> parts;
+  for (int i0 = 0; i0 < count; i0 += kRangeRows) {
+    const int i1 = std::min(count, i0 + kRangeRows);
+    needed.clear();
+    for (int m = R.start[static_cast<std::size_t>(i0)]; m < R.start[static_cast<std::size_t>(i1)]; ++m) {
+      const int k = R.column[static_cast<std::size_t>(m)];
+      if (slot[static_cast<std::size_t>(k)] < 0) {
+        slot[static_cast<std::size_t>(k)] = static_cast<int>(needed.size());
+        needed.push_back(k);
+      }
+    }
+    ap.assign(needed.size(), {});
+    tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, needed.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
+          BlockRowAccumulator& row = accumulators.local();
+          for (std::size_t t = r.begin(); t != r.end(); ++t) {
+            const auto k = static_cast<std::size_t>(needed[t]);
+            for (int m = A.start[k]; m < A.start[k + 1]; ++m) {
+              const int l = A.column[static_cast<std::size_t>(m)];
+              const Matrix3& a = A.block[static_cast<std::size_t>(m)];
+              for (int q = P.start[static_cast<std::size_t>(l)]; q < P.start[static_cast<std::size_t>(l) + 1]; ++q)
+                row[P.column[static_cast<std::size_t>(q)]].noalias() += a * P.block[static_cast<std::size_t>(q)];
+            }
+            ap[t] = row.take();
+          }
+        });
+    parts.push_back(build_block_rows(i1 - i0, P.cols, [&](int r, BlockRowAccumulator& row) {
+      const auto i = static_cast<std::size_t>(i0 + r);
+      for (int m = R.start[i]; m < R.start[i + 1]; ++m) {
+        const Matrix3& left = R.block[static_cast<std::size_t>(m)];
+        for (const auto& [column, block] :
+             ap[static_cast<std::size_t>(slot[static_cast<std::size_t>(R.column[static_cast<std::size_t>(m)])])])
+          row[column].noalias() += left * block;
+      }
+    }));
+    for (const int k : needed) slot[static_cast<std::size_t>(k)] = -1;
+  }
+  return stack_block_rows(std::move(parts), P.cols);
+}
+
+}  // namespace
+
 AdditiveMultilevel::AdditiveMultilevel(BlockSparseMatrix A, int coarsest_unknowns) {
   if (A.rows != A.cols || A.start.size() != static_cast<std::size_t>(A.rows) + 1)
     throw std::invalid_argument("multilevel: the matrix must be square");
@@ -313,25 +368,7 @@ AdditiveMultilevel::AdditiveMultilevel(BlockSparseMatrix A, int coarsest_unknown
       }
     });
     level.R = transpose(level.P);
-    // Galerkin: A_c = R (A P).
-    const BlockSparseMatrix AP = build_block_rows(A.rows, count, [&](int k, BlockRowAccumulator& row) {
-      for (int m = A.start[static_cast<std::size_t>(k)]; m < A.start[static_cast<std::size_t>(k) + 1]; ++m) {
-        const int l = A.column[static_cast<std::size_t>(m)];
-        const Matrix3& a = A.block[static_cast<std::size_t>(m)];
-        for (int q = level.P.start[static_cast<std::size_t>(l)]; q < level.P.start[static_cast<std::size_t>(l) + 1];
-             ++q)
-          row[level.P.column[static_cast<std::size_t>(q)]].noalias() += a * level.P.block[static_cast<std::size_t>(q)];
-      }
-    });
-    BlockSparseMatrix coarse = build_block_rows(count, count, [&](int i, BlockRowAccumulator& row) {
-      for (int m = level.R.start[static_cast<std::size_t>(i)]; m < level.R.start[static_cast<std::size_t>(i) + 1];
-           ++m) {
-        const int k = level.R.column[static_cast<std::size_t>(m)];
-        const Matrix3& r = level.R.block[static_cast<std::size_t>(m)];
-        for (int q = AP.start[static_cast<std::size_t>(k)]; q < AP.start[static_cast<std::size_t>(k) + 1]; ++q)
-          row[AP.column[static_cast<std::size_t>(q)]].noalias() += r * AP.block[static_cast<std::size_t>(q)];
-      }
-    });
+    BlockSparseMatrix coarse = galerkin_product(A, level.P, level.R);
     levels_.push_back(std::move(level));
     A = std::move(coarse);
   }
