@@ -152,6 +152,10 @@ MethodRun run_flow(const Mesh& mesh, const ReferenceSurface* reference, const Fl
                                     "guard {:.3f} s; {} vertices limited by the guard",
                                     r.seconds_curvature, r.seconds_assembly, r.seconds_solve, r.seconds_projection,
                                     r.seconds_guard, r.limited_vertices));
+  if (r.flat)
+    tell(callbacks.phase, fmt::format("the {} has no curvature radius below {} times its bounding-box diagonal: "
+                                      "nothing to enhance, no solve ran (flow.h)",
+                                      reference ? "reference" : "surface", 1 / kFlatCurvature));
   if (options.density.passes > 0)
     tell(callbacks.phase, fmt::format("{} density passes {:.3f} s; {} vertices limited by their guard",
                                       options.density.passes, r.seconds_density, r.density_limited_vertices));

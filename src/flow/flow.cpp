@@ -102,6 +102,14 @@ FlowResult flow_on_manifold_split(const Vertices& V, const Faces& F, const Topol
   return result;
 }
 
+// No curvature radius below 1000 bounding-box diagonals (flow.h, kFlatCurvature): normalised
+// units, where the mean edge length is 1.
+bool flat_at_its_scale(const Curvature& c, const Vertices& input) {
+  double largest = 0;
+  for (Eigen::Index i = 0; i < c.k1.size(); ++i) largest = std::max({largest, std::abs(c.k1[i]), std::abs(c.k2[i])});
+  return largest * bounding_box(input).diagonal() < kFlatCurvature;
+}
+
 // The rounds of vertex_flow on a manifold, oriented mesh with valid options: on the input, or
 // with frames, curvature and projection from the reference S (vertex_flow_on_reference).
 FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options,
@@ -156,6 +164,15 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
     if (round == 0 && options.density.passes > 0) surface_curvature = frame.curvature;
     report.d = frame.d;
     report.seconds_curvature += seconds_since(start);
+    // Nothing to enhance (flow.h): the input stays; on S the vertices are only put onto it.
+    if (round == 0 && flat_at_its_scale(frame.curvature, input)) {
+      report.flat = true;
+      if (surface && options.project_to_input) {
+        project(X, free_rows);
+        guard(X, start_of_round, criteria, fixed, topology, options.guard, reproject, shortened);
+      }
+      break;
+    }
     X = solver.solve(std::move(frame), options.weights, report);  // frees its curvature once assembled
     if (!X.allFinite()) throw std::runtime_error("vertex flow: the solver diverged");
     if (options.project_to_input) {
@@ -199,7 +216,11 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
   report.limited_vertices = static_cast<Index>(std::count(shortened.begin(), shortened.end(), 1));
   report.d *= setup.scale;
 
-  result.V = (X * setup.scale).rowwise() + setup.centroid;
+  // A flat surface's unmoved vertices come back bit for bit, not through the normalisation's round trip.
+  if (report.flat && X == input)
+    result.V = V;
+  else
+    result.V = (X * setup.scale).rowwise() + setup.centroid;
   // Fixed vertices are returned bit for bit.
   for (Index i = 0; i < n; ++i) {
     if (fixed[static_cast<std::size_t>(i)]) result.V.row(i) = V.row(i);

@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <fstream>
 #include <regex>
 #include <sstream>
@@ -576,6 +577,41 @@ TEST(CliEnhance, RefusesAReportOverTheOutput) {
   EXPECT_EQ(r.exit_code, 1);
   EXPECT_NE(r.err.find("would overwrite another output of the same command"), std::string::npos) << r.err;
   EXPECT_FALSE(std::filesystem::exists(out));
+}
+
+}  // namespace
+}  // namespace vertexflow
+
+namespace vertexflow {
+namespace {
+
+// Issue 32: a flat grid in z = 0 and a bumpy one (24 x 24 vertices over the unit square, two
+// triangles per cell), written as OBJ.
+void write_grid(const std::filesystem::path& path, double bump, double scale = 1, double shift = 0) {
+  constexpr int n = 24;
+  std::ofstream out(path);
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i) {
+      const double x = i / (n - 1.0), y = j / (n - 1.0);
+      out << "v " << scale * x + shift << ' ' << scale * y << ' '
+          << scale * bump * std::sin(3 * M_PI * x) * std::sin(3 * M_PI * y) << '\n';
+    }
+  for (int j = 0; j + 1 < n; ++j)
+    for (int i = 0; i + 1 < n; ++i) {
+      const int a = j * n + i + 1;
+      out << "f " << a << ' ' << a + 1 << ' ' << a + n + 1 << "\nf " << a << ' ' << a + n + 1 << ' ' << a + n << '\n';
+    }
+}
+
+// Item 1: the flat grid comes back as it went in (before: its 484 inner vertices moved by up to
+// 2.34 mean edge lengths) and the run says why.
+TEST(CliEnhance, AFlatMeshComesBackUnchanged) {
+  test::ScratchDir dir("cli-enhance-flat");
+  write_grid(dir.file("flat.obj"), 0);
+  const auto r = run_cli("enhance " + test::quoted(dir.file("flat.obj")) + " " + test::quoted(dir.file("out.obj")));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.err.find("nothing to enhance"), std::string::npos) << r.err;
+  EXPECT_EQ(read_mesh(dir.file("out.obj")).V, read_mesh(dir.file("flat.obj")).V);
 }
 
 }  // namespace

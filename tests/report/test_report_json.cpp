@@ -114,7 +114,7 @@ TEST(ReportJson, FlowReportEveryFieldInItsSection) {
   auto& [mean_edge_length, d, solver_error, flipped_before_guard, low_quality_before_guard, limited_vertices,
          density_limited_vertices, fixed_vertices, held_non_manifold_vertices, reoriented_faces, cut_edges,
          seconds_curvature, seconds_assembly, seconds_solve, seconds_projection, seconds_guard, seconds_density,
-         seconds_factorization, solver_used, solver_iterations] = report;
+         seconds_factorization, solver_used, solver_iterations, flat] = report;
   mean_edge_length = 0.5;
   d = 2.5;
   solver_error = 1e-8;
@@ -135,13 +135,15 @@ TEST(ReportJson, FlowReportEveryFieldInItsSection) {
   seconds_factorization = 0.75;
   solver_used = LinearSolver::Direct;
   solver_iterations = 42;
+  flat = true;
   const nlohmann::json j = report;
   const nlohmann::json expected = {{"solver",
                                     {{"relative_residual", 1e-8},
                                      {"d", 2.5},
                                      {"mean_edge_length", 0.5},
                                      {"method", "direct (CHOLMOD)"},
-                                     {"iterations", 42}}},
+                                     {"iterations", 42},
+                                     {"flat", true}}},
                                    {"guard",
                                     {{"faces_bad_before_guard", 1},
                                      {"faces_low_quality_before_guard", 2},
