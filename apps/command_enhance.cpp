@@ -143,8 +143,10 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
   add_enhance_options(command, o->given);
   command->add_option("--pin", o->pin_file, "File of vertex indices (0-based) to hold in place");
   command->add_option("--reference", o->reference_file,
-                      "Dense mesh of the true surface, in the input's units and overlapping it: fit the vertices to "
-                      "it (reference mode; fit.h) instead of the paper's flow");
+                      "Dense mesh of the true surface, in the input's units and overlapping it: its bounding box "
+                      "must overlap the input's over at least half its extent along each axis and its diagonal be "
+                      "within 10x the input's (enhance.h), or it is refused. Fit the vertices to it (reference mode; "
+                      "fit.h) instead of the paper's flow");
   command->add_option("--report", o->report_file, "Write a JSON report: options, timings per phase, metrics");
   command->add_option("--html", o->html_file,
                       "Write an HTML report: both meshes in 3D, colour maps, histograms, metrics");

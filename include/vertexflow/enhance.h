@@ -150,12 +150,28 @@ struct EnhanceResult {
   std::vector<std::string> warnings;
 };
 
+/// What a reference must be to stand for the input's surface. Each axis-aligned bounding box is
+/// grown by 1% of the input's diagonal (flat inputs and references have boxes of zero
+/// thickness); then the boxes must overlap along every axis over at least half of the input's
+/// extent (kReferenceCoverage), and the diagonals differ by at most kReferenceSizeFactor either
+/// way. A reference shifted by 1e6, scaled by 1e-9 or reduced to one triangle was fitted or
+/// flowed to, with exit 0, moving vertices by 6-8 edge lengths. The bundled pairs (bunny_uniform
+/// and bunny_adaptive on bunny, amo_adaptive on amo) measure diagonals within 0.2% and a full
+/// overlap. Throws std::invalid_argument, one line: "the reference NAME ..." (NAME left out for
+/// an unnamed reference) and the rule.
+inline constexpr double kReferenceCoverage = 0.5;
+inline constexpr double kReferenceSizeFactor = 10;
+void check_reference_fits(const Mesh& mesh, const ReferenceSurface& reference);
+
 /// Runs the mode `options` choose on `mesh` (its V, F, attributes and comments; the comments'
 /// provenance lines let smooth mode hold an input that an earlier fit placed off its surface),
 /// with `reference` for the reference modes (nullptr otherwise). Validates first
 /// (validate_enhance_options, OptionNaming::Cpp; MeshAttributes::validate, as an
 /// EnhanceOptionError) and throws as the chosen method does (std::invalid_argument for a mesh it
 /// refuses).
+///
+/// A reference must be the input's surface in the input's units (check_reference_fits): a
+/// std::invalid_argument, one line naming the reference, refuses one that does not.
 ///
 /// The face list comes back as it went in. Faces the methods cannot work on (a repeated vertex,
 /// zero area by mesh.h's bound, a repeat of an earlier face) stay in it, and their vertices are

@@ -286,6 +286,38 @@ nlohmann::json flip_and_refit(const Mesh& input, const ReferenceSurface* referen
 
 }  // namespace
 
+void check_reference_fits(const Mesh& mesh, const ReferenceSurface& reference) {
+  const BoundingBox input = bounding_box(mesh.V), dense = bounding_box(reference.vertices());
+  const double input_size = input.diagonal(), size = dense.diagonal();
+  if (!(input_size > 0)) return;  // the methods refuse a mesh without extent, in their words
+  const std::string name = reference.name().empty() ? "the reference" : "the reference " + reference.name();
+  const std::string rule = fmt::format(
+      "a reference must be the input's surface in the input's units (bounding boxes overlapping over at least {:g}% "
+      "of the input's extent along each axis, diagonals within a factor {:g})",
+      100 * kReferenceCoverage, kReferenceSizeFactor);
+  const double grow = 0.01 * input_size;  // boxes of flat inputs and references have no thickness
+  double worst = 1;
+  int worst_axis = 0;
+  for (int a = 0; a < 3; ++a) {
+    const double overlap = std::min(input.max[a], dense.max[a]) - std::max(input.min[a], dense.min[a]);
+    if (overlap < -2 * grow)
+      throw std::invalid_argument(
+          fmt::format("{} does not overlap the input: their bounding boxes are {:.6g} apart "
+                      "along {} (the input's diagonal is {:.6g}); {}",
+                      name, -overlap, "xyz"[a], input_size, rule));
+    const double covered = (overlap + 2 * grow) / (input.max[a] - input.min[a] + 2 * grow);
+    if (covered < worst) worst = covered, worst_axis = a;
+  }
+  if (!(size * kReferenceSizeFactor >= input_size && size <= kReferenceSizeFactor * input_size))
+    throw std::invalid_argument(
+        fmt::format("{} is {:.3g} times the input's size (bounding-box diagonals {:.6g} and "
+                    "{:.6g}); {}",
+                    name, size / input_size, size, input_size, rule));
+  if (worst < kReferenceCoverage)
+    throw std::invalid_argument(fmt::format("{} overlaps the input over only {:.1f}% of its extent along {}; {}", name,
+                                            100 * worst, "xyz"[worst_axis], rule));
+}
+
 EnhanceMode enhance_mode(const EnhanceOptions& options, bool has_reference) {
   return mode_of(options, has_reference, OptionNaming::Cpp);
 }
@@ -555,6 +587,7 @@ class SeamSides {
 EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const EnhanceOptions& options,
                       const EnhanceCallbacks& callbacks) {
   validate_enhance_options(options, reference != nullptr, mesh.num_vertices());
+  if (reference) check_reference_fits(mesh, *reference);
   try {
     mesh.attributes.validate(mesh.num_vertices(), mesh.num_faces());
   } catch (const std::invalid_argument& e) {

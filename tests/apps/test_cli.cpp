@@ -417,8 +417,10 @@ TEST(CliEnhance, NonManifoldInputIsHeldWhereItMustBeOrRefusedWithStrict) {
 
   // The same with the flow on a reference: held without --strict; with it, the one line names
   // the input alone, not the reference read after it (it used to read "REFERENCE: INPUT: ...").
-  const std::string on_reference =
-      " --reference " + test::quoted_data_path("sphere_low.off") + " --reference-method flow";
+  // The reference is the bowtie's plane: one that is not its surface is refused (enhance.h).
+  const auto plane = dir.file("plane.obj");
+  { std::ofstream(plane) << "v -1 -1 0\nv 1 -1 0\nv 1 1 0\nv -1 1 0\nf 1 2 3\nf 1 3 4\n"; }
+  const std::string on_reference = " --reference " + shell_quote(plane.string()) + " --reference-method flow";
   const auto held_on_reference =
       run_cli("enhance " + shell_quote(bowtie.string()) + " " + shell_quote(out.string()) + on_reference);
   EXPECT_EQ(held_on_reference.exit_code, 0) << held_on_reference.err;
@@ -431,7 +433,7 @@ TEST(CliEnhance, NonManifoldInputIsHeldWhereItMustBeOrRefusedWithStrict) {
                 "vertexflow: error: " + bowtie.string() + ": vertex flow: the mesh is not manifold", 0),
             0)
       << strict_on_reference.err;
-  EXPECT_EQ(strict_on_reference.err.find("sphere_low.off"), std::string::npos) << strict_on_reference.err;
+  EXPECT_EQ(strict_on_reference.err.find("plane.obj"), std::string::npos) << strict_on_reference.err;
   EXPECT_FALSE(std::filesystem::exists(out));
 }
 
@@ -612,6 +614,36 @@ TEST(CliEnhance, AFlatMeshComesBackUnchanged) {
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("nothing to enhance"), std::string::npos) << r.err;
   EXPECT_EQ(read_mesh(dir.file("out.obj")).V, read_mesh(dir.file("flat.obj")).V);
+}
+
+// Item 2: a reference shifted by 1e6, scaled by 1e-9 or reduced to one triangle is refused with
+// one line naming both files, with either reference method; the help says what a reference must be.
+TEST(CliEnhance, AReferenceThatDoesNotOverlapIsRefusedNamingBothFiles) {
+  test::ScratchDir dir("cli-enhance-reference");
+  const auto input = dir.file("bumpy.obj");
+  write_grid(input, 0.08);
+  write_grid(dir.file("shifted.obj"), 0.08, 1, 1e6);
+  write_grid(dir.file("tiny.obj"), 0.08, 1e-9);
+  { std::ofstream(dir.file("triangle.obj")) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n"; }
+  for (const char* reference : {"shifted.obj", "tiny.obj", "triangle.obj"})
+    for (const char* method : {"fit", "flow"}) {
+      SCOPED_TRACE(std::string(reference) + ", " + method);
+      const auto r = run_cli("--quiet enhance " + test::quoted(input) + " " + test::quoted(dir.file("out.obj")) +
+                             " --reference " + test::quoted(dir.file(reference)) + " --reference-method " + method);
+      EXPECT_EQ(r.exit_code, 1);
+      EXPECT_EQ(
+          r.err.rfind("vertexflow: error: " + input.string() + ": the reference " + dir.file(reference).string() + " ",
+                      0),
+          0u)
+          << r.err;
+      EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+      EXPECT_FALSE(std::filesystem::exists(dir.file("out.obj")));
+    }
+  const auto same = run_cli("--quiet enhance " + test::quoted(input) + " " + test::quoted(dir.file("out.obj")) +
+                            " --reference " + test::quoted(input));
+  EXPECT_EQ(same.exit_code, 0) << same.err;
+  const auto help = run_cli("enhance --help");
+  EXPECT_NE(help.out.find("within 10x the input's"), std::string::npos) << help.out;
 }
 
 }  // namespace

@@ -15,6 +15,7 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
 
 namespace vertexflow {
 namespace {
@@ -272,6 +273,68 @@ TEST(Enhance, ReferenceFitBringsAnInscribedSphereToTheSphere) {
   EXPECT_LT(after, 0.6 * before);  // measured 0.24x; an engine that did nothing gives 1x
   // Vertices off the sphere's inscribed polyhedron: radii above 1 where the faces sag inside.
   EXPECT_GT(r.mesh.V.rowwise().norm().maxCoeff(), 1.0);
+}
+
+// Issue 32 item 2: a reference that is not the input's surface in its units is refused, in both
+// reference methods, with one line naming it (check_reference_fits). Before, each was fitted or
+// flowed to with no word, moving vertices by 6-8 edge lengths.
+TEST(Enhance, AReferenceThatIsNotTheInputsSurfaceIsRefused) {
+  const SpherePair pair;  // a bumpy input would do as well: only the boxes matter
+  const Mesh dense = test::icosphere(1.0, 5);
+  auto moved = [&](double scale, const Eigen::RowVector3d& shift) {
+    Vertices V = dense.V * scale;
+    V.rowwise() += shift;
+    return V;
+  };
+  struct Case {
+    const char* what;
+    Vertices V;
+    Faces F;
+    const char* message;
+  };
+  const Case cases[] = {
+      {"shifted by 1e6", moved(1, {1e6, 0, 0}), dense.F, "does not overlap the input"},
+      {"scaled by 1e-9", moved(1e-9, {0, 0, 0}), dense.F, "1e-09 times the input's size"},
+      {"scaled by 11", moved(11, {0, 0, 0}), dense.F, "11 times the input's size"},
+      {"one triangle", (Vertices(3, 3) << -1, -1, 0, 1, -1, 0, 0, 1, 0).finished(), (Faces(1, 3) << 0, 1, 2).finished(),
+       "over only 3.3% of its extent along z"},
+      {"shifted by 1.2 radii", moved(1, {0, 0, 1.2}), dense.F, "over only 42.0% of its extent along z"}};
+  for (const Case& c : cases) {
+    const ReferenceSurface reference(c.V, c.F, "R.off");
+    for (const ReferenceMethod method : {ReferenceMethod::Fit, ReferenceMethod::Flow}) {
+      SCOPED_TRACE(::testing::Message() << c.what << (method == ReferenceMethod::Fit ? ", fit" : ", flow"));
+      EnhanceOptions o;
+      o.reference_method = method;
+      try {
+        enhance(pair.coarse, &reference, o);
+        ADD_FAILURE() << "accepted";
+      } catch (const std::invalid_argument& e) {
+        const std::string line = e.what();
+        EXPECT_EQ(line.rfind("the reference R.off ", 0), 0u) << line;
+        EXPECT_NE(line.find(c.message), std::string::npos) << line;
+        EXPECT_EQ(line.find('\n'), std::string::npos) << line;
+      }
+    }
+  }
+  // Within the bounds: 9 times the size (the input inside it), and a flat reference under a flat
+  // input 1e-12 above it (the boxes are grown by 1% of the input's diagonal).
+  EXPECT_NO_THROW(check_reference_fits(pair.coarse, ReferenceSurface(moved(9, {0, 0, 0}), dense.F)));
+  Mesh square;
+  square.V = (Vertices(4, 3) << 0, 0, 1e-12, 1, 0, 1e-12, 1, 1, 1e-12, 0, 1, 1e-12).finished();
+  square.F = (Faces(2, 3) << 0, 1, 2, 0, 2, 3).finished();
+  EXPECT_NO_THROW(check_reference_fits(square, ReferenceSurface(square.V.array() - 1e-12, square.F)));
+}
+
+// The bundled pairs stand for their inputs' surfaces: diagonals within 0.2%, boxes overlapping
+// fully (measured: bunny_uniform and bunny_adaptive on bunny, amo_adaptive on amo).
+TEST(Enhance, TheBundledReferencePairsFit) {
+  for (const auto& [coarse, fine] :
+       {std::pair{"bunny_uniform.off", "bunny.off"}, std::pair{"bunny_adaptive.off", "bunny.off"},
+        std::pair{"amo_adaptive.off", "amo.off"}}) {
+    SCOPED_TRACE(coarse);
+    const Mesh dense = read_mesh(test::data_path(fine));
+    EXPECT_NO_THROW(check_reference_fits(read_mesh(test::data_path(coarse)), ReferenceSurface(dense.V, dense.F, fine)));
+  }
 }
 
 }  // namespace
