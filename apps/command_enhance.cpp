@@ -1,6 +1,7 @@
 // `vertexflow enhance IN OUT [...]`: the enhance engine (enhance.h) on files: parsing, reading,
 // writing, printing, and the JSON and HTML reports of what it did.
 #include "cli_common.h"
+#include "memory_estimate.h"
 
 #include "vertexflow/enhance.h"
 #include "vertexflow/html_report.h"
@@ -184,6 +185,9 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
       reference.emplace(std::move(dense.V), std::move(dense.F), o->reference_file);
     }
     const ReferenceSurface* reference_pointer = reference ? &*reference : nullptr;
+    // One line now rather than the OOM killer later (memory_estimate.h).
+    require_memory_for_enhance(o->input, mesh.num_vertices(), !o->report_file.empty() || !o->html_file.empty(),
+                               reference ? static_cast<Index>(reference->vertices().rows()) : 0);
     // Trees over the reference's faces that the run and its report build (reference_surface.h).
     const std::uint64_t trees_before = reference ? distance_trees_built(reference->faces().rows()) : 0;
     EnhanceResult result;
@@ -217,6 +221,8 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
       report["reference"] = o->reference_file;
       report["reference_trees_built"] = distance_trees_built(reference->faces().rows()) - trees_before;
     }
+    // The whole process's peak so far (the run, and the metrics above).
+    report["peak_memory_bytes"] = peak_resident_bytes();
     if (!o->report_file.empty()) {
       write_text_file(o->report_file, report.dump(2) + "\n");
       phase("report written to " + o->report_file);

@@ -127,7 +127,7 @@ TEST(CliReport, EnhanceReportHoldsTheFlowsOptionsAndReport) {
   for (const char* key : {"solver", "solver_tolerance", "max_halvings", "curvature"})
     EXPECT_TRUE(report["options"].contains(key)) << key;
   EXPECT_EQ(keys(report), with_metrics({"input", "output", "method", "options", "solver", "guard", "non_manifold",
-                                        "seconds", "provenance"}));
+                                        "seconds", "provenance", "peak_memory_bytes"}));
   EXPECT_EQ(report["provenance"], "vertexflow enhance --surface input");  // the line added to OUT (provenance.h)
   EXPECT_EQ(keys(report["seconds"]), (std::set<std::string>{"read", "curvature", "assembly", "solve", "factorization",
                                                             "projection", "guard", "density", "write"}));
@@ -159,7 +159,7 @@ TEST(CliReport, UnsharpReportHoldsItsOwnSections) {
   EXPECT_EQ(report["options"], nlohmann::json(options));
   EXPECT_EQ(report["method"], "unsharp");
   EXPECT_EQ(keys(report), with_metrics({"input", "output", "method", "options", "fixed_vertices", "non_manifold",
-                                        "seconds", "provenance"}));
+                                        "seconds", "provenance", "peak_memory_bytes"}));
   EXPECT_EQ(report["provenance"], "vertexflow enhance --method unsharp");
   EXPECT_EQ(keys(report["seconds"]), (std::set<std::string>{"read", "unsharp", "write"}));
   const Mesh mesh = read_mesh(input);

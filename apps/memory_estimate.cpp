@@ -1,0 +1,101 @@
+// Memory estimate before a run (memory_estimate.h).
+#include "memory_estimate.h"
+
+#include <fmt/format.h>
+
+#include <sys/resource.h>
+
+#include <algorithm>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+namespace vertexflow::cli {
+namespace {
+
+// Measured peaks per vertex (docs/benchmarks.md, "Memory by phase" and "After the first
+// changes"), rounded up: the flow's multilevel path 1,460 B (arm1m, arm10m), the block-Jacobi
+// path 1,100 B; with --report 1,734 B (arm1m, the metrics' peak). A reference vertex costs its
+// distance tree, curvature and copies.
+constexpr double kFlowBytesPerVertex = 1600;
+constexpr double kReportBytesPerVertex = 1800;
+constexpr double kReferenceBytesPerVertex = 900;
+
+// A "Key:   N kB" line of a /proc file, in bytes.
+std::optional<std::uint64_t> proc_kib(const char* file, const std::string& key) {
+  std::ifstream in(file);
+  std::string line;
+  while (std::getline(in, line))
+    if (line.compare(0, key.size(), key) == 0 && line.size() > key.size() && line[key.size()] == ':') {
+      std::istringstream fields(line.substr(key.size() + 1));
+      std::uint64_t kib = 0;
+      if (fields >> kib) return kib * 1024;
+    }
+  return std::nullopt;
+}
+
+std::optional<std::uint64_t> read_number(const char* file) {
+  std::ifstream in(file);
+  std::string word;
+  if (!(in >> word) || word == "max") return std::nullopt;
+  try {
+    return std::stoull(word);
+  } catch (const std::exception&) {
+    return std::nullopt;
+  }
+}
+
+double gib(std::uint64_t bytes) {
+  return static_cast<double>(bytes) / (1024.0 * 1024.0 * 1024.0);
+}
+
+}  // namespace
+
+std::uint64_t estimated_enhance_peak_bytes(Index vertices, bool with_report, Index reference_vertices) {
+  const double per_vertex = with_report ? kReportBytesPerVertex : kFlowBytesPerVertex;
+  return static_cast<std::uint64_t>(per_vertex * vertices + kReferenceBytesPerVertex * reference_vertices);
+}
+
+std::optional<AvailableMemory> available_memory() {
+  std::optional<AvailableMemory> least;
+  auto consider = [&](std::optional<std::uint64_t> bytes, const char* what) {
+    if (bytes && (!least || *bytes < least->bytes)) least = AvailableMemory{*bytes, what};
+  };
+  consider(proc_kib("/proc/meminfo", "MemAvailable"), "MemAvailable");
+  rlimit limit{};
+  if (getrlimit(RLIMIT_AS, &limit) == 0 && limit.rlim_cur != RLIM_INFINITY) {
+    const std::uint64_t used = proc_kib("/proc/self/status", "VmSize").value_or(0);
+    consider(limit.rlim_cur > used ? limit.rlim_cur - used : 0, "ulimit -v");
+  }
+  if (const auto max = read_number("/sys/fs/cgroup/memory.max")) {
+    const std::uint64_t current = read_number("/sys/fs/cgroup/memory.current").value_or(0);
+    consider(*max > current ? *max - current : 0, "cgroup memory.max");
+  }
+  return least;
+}
+
+std::uint64_t resident_bytes() {
+  return proc_kib("/proc/self/status", "VmRSS").value_or(0);
+}
+
+std::uint64_t peak_resident_bytes() {
+  rusage usage{};
+  if (getrusage(RUSAGE_SELF, &usage) != 0) return 0;
+  return static_cast<std::uint64_t>(usage.ru_maxrss) * 1024;  // KiB on Linux
+}
+
+void require_memory_for_enhance(const std::string& path, Index vertices, bool with_report, Index reference_vertices) {
+  const std::optional<AvailableMemory> available = available_memory();
+  if (!available) return;
+  const std::uint64_t estimate = estimated_enhance_peak_bytes(vertices, with_report, reference_vertices);
+  const std::uint64_t held = resident_bytes();
+  const std::uint64_t more = estimate > held ? estimate - held : 0;
+  if (more <= available->bytes) return;
+  throw std::runtime_error(
+      fmt::format("{}: enhancing {} vertices{} needs about {:.2f} GiB at its peak (estimated from measured runs, "
+                  "docs/benchmarks.md; {:.2f} GiB of it held already), but only {:.2f} GiB more is available ({})",
+                  path, vertices, with_report ? " with a report" : "", gib(estimate), gib(held), gib(available->bytes),
+                  available->limited_by));
+}
+
+}  // namespace vertexflow::cli
