@@ -109,8 +109,14 @@ enum class LinearSolver {
 /// +19% (the flow alone: -5% to +6%), and on thin parts the Hausdorff distance rises (horse:
 /// +97%). About 56 ms per pass at 90k vertices and 1.3 s at 1M (docs/benchmarks.md).
 struct DensityRelaxation {
+  /// The largest exponent: the densities of (0.1 + |k1| + |k2|)^10 span 1e-10 to 1e30 for
+  /// curvatures up to 1e3 per mean edge length (camelhead's largest: 62). At 1e5 every density
+  /// was 0 (|k1| + |k2| < 0.9) or inf, and a vertex had no centroid or a NaN one (issue 32: the
+  /// same output as without the passes, exit 0). Exponent 2 already asks for edge lengths like
+  /// 1 / |k|.
+  static constexpr double max_exponent = 10;
   int passes = 0;         ///< 0: the paper's flow alone
-  double exponent = 2.0;  ///< >= 0
+  double exponent = 2.0;  ///< in [0, max_exponent]
   double epsilon = 0.1;   ///< > 0: the density of a flat region, per mean edge length
   double step = 0.5;      ///< in (0, 1]: the fraction of the way to the centroid per pass
 };
@@ -208,16 +214,16 @@ struct FlowResult {
 
 /// Checks every option against its allowed range: lambda > 0, mu >= 0, epsilon > 0, sliver >= 0
 /// (all finite), d_percentile in [0, 100], iterations >= 1, density.passes in [0, 1000],
-/// density.exponent >= 0, density.epsilon > 0, density.step in (0, 1] (all finite), no density
-/// passes without project_to_input, feature_angle >= 0, the guard's options
-/// (validate_guard_options), solver_tolerance in (0, 1), curvature.smoothing_rounds >= 0, and
-/// (when num_vertices >= 0) every pinned index in [0, num_vertices). Throws std::invalid_argument naming the first
-/// option out of range and its allowed range.
+/// density.exponent in [0, DensityRelaxation::max_exponent], density.epsilon > 0, density.step in (0, 1] (all finite),
+/// no density passes without project_to_input, feature_angle >= 0, the guard's options (validate_guard_options),
+/// solver_tolerance in (0, 1), curvature.smoothing_rounds >= 0, and (when num_vertices >= 0) every pinned index in [0,
+/// num_vertices). Throws std::invalid_argument naming the first option out of range and its allowed range.
 void validate_flow_options(const FlowOptions& options, Index num_vertices = -1);
 
 /// Moves the vertices of (V, F) by vertex flow. Throws std::invalid_argument for options out
 /// of range (validate_flow_options), an empty mesh, a non-finite coordinate, a mesh without
-/// extent, or (with refuse_non_manifold) a non-manifold or inconsistently oriented mesh.
+/// extent, (with refuse_non_manifold) a non-manifold or inconsistently oriented mesh, or density
+/// passes whose sizing density is not a finite positive number at some vertex.
 FlowResult vertex_flow(const Vertices& V, const Faces& F, const FlowOptions& options = {});
 
 /// The same with the topology of F (build_topology(F, V.rows())) computed by the caller, who

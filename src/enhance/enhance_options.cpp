@@ -207,9 +207,9 @@ std::vector<EnhanceOptionSpec> make_specs() {
   t.push_back(ranged(member_spec(
                          "density_exponent", "flow.density.exponent", "--density-exponent", K::Double, kFlowModes,
                          "Density passes: sizing density (0.1 + (|k1| + |k2|) * mean edge length)^this; 0 "
-                         "equalises areas",
+                         "equalises areas; at most 10, where the density stays finite (flow.h)",
                          [](auto& o) -> auto& { return o.flow.density.exponent; }),
-                     0, kInf, false, true));
+                     0, DensityRelaxation::max_exponent));
   t.push_back(ranged(member_spec(
                          "density_epsilon", "flow.density.epsilon", "--density-epsilon", K::Double, kFlowModes,
                          "Density passes: the density of a flat region, per mean edge length",

@@ -13,6 +13,8 @@
 #include "vertexflow/manifold_split.h"
 #include "vertexflow/timing.h"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -39,8 +41,9 @@ void validate_flow_options(const FlowOptions& o, Index num_vertices) {
   require(o.solver_tolerance > 0 && o.solver_tolerance < 1, "solver_tolerance must be in (0, 1)");
   require(o.curvature.smoothing_rounds >= 0, "curvature.smoothing_rounds must be >= 0");
   require(o.density.passes >= 0 && o.density.passes <= 1000, "density.passes must be in [0, 1000]");
-  require(std::isfinite(o.density.exponent) && o.density.exponent >= 0,
-          "density.exponent must be a finite number >= 0");
+  require(std::isfinite(o.density.exponent) && o.density.exponent >= 0 &&
+              o.density.exponent <= DensityRelaxation::max_exponent,
+          "density.exponent must be in [0, 10] (DensityRelaxation::max_exponent)");
   require(std::isfinite(o.density.epsilon) && o.density.epsilon > 0, "density.epsilon must be a finite number > 0");
   require(std::isfinite(o.density.step) && o.density.step > 0 && o.density.step <= 1, "density.step must be in (0, 1]");
   require(o.density.passes == 0 || o.project_to_input,
@@ -110,6 +113,19 @@ bool flat_at_its_scale(const Curvature& c, const Vertices& input) {
   return largest * bounding_box(input).diagonal() < kFlatCurvature;
 }
 
+// The sizing density of the density passes, refused unless finite and positive everywhere: 0 or
+// inf (an extreme exponent or epsilon) gave no centroid or a NaN one, and passes that did nothing.
+Eigen::VectorXd checked_density(const Curvature& c, const DensityRelaxation& options) {
+  Eigen::VectorXd density = sizing_density(c, options);
+  for (Eigen::Index i = 0; i < density.size(); ++i)
+    if (!std::isfinite(density[i]) || !(density[i] > 0))
+      throw std::invalid_argument(fmt::format(
+          "vertex flow: the density passes' sizing density ({} + |k1| + |k2|)^{} is {} at vertex {} (|k1| + |k2| = "
+          "{:.6g} per mean edge length); lower the exponent or raise the density epsilon",
+          options.epsilon, options.exponent, density[i], i, std::abs(c.k1[i]) + std::abs(c.k2[i])));
+  return density;
+}
+
 // The rounds of vertex_flow on a manifold, oriented mesh with valid options: on the input, or
 // with frames, curvature and projection from the reference S (vertex_flow_on_reference).
 FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options,
@@ -153,15 +169,15 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
   // projected onto S).
   Reprojection reproject;
   if (options.project_to_input && !surface) reproject = project;
-  // The surface's curvature at the input positions, for the density passes.
-  Curvature surface_curvature;
+  // The sizing density of the density passes, from the surface's curvature at the input positions.
+  Eigen::VectorXd density;
   for (int round = 0; round < options.iterations; ++round) {
     const Vertices start_of_round = X;
     // One solve: minimise the energy for positions X, frozen curvature of X.
     auto start = Clock::now();
     FlowFrame frame = surface ? flow_frame_on_reference(X, F, topology, options, setup.sliver_faces, *surface, fixed)
                               : flow_frame(X, F, topology, options, setup.sliver_faces);
-    if (round == 0 && options.density.passes > 0) surface_curvature = frame.curvature;
+    if (round == 0 && options.density.passes > 0) density = checked_density(frame.curvature, options.density);
     report.d = frame.d;
     report.seconds_curvature += seconds_since(start);
     // Nothing to enhance (flow.h): the input stays; on S the vertices are only put onto it.
@@ -195,7 +211,6 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
     // counts: the passes' small steps are shortened far more often than a solve's, and the
     // guard's before-counts describe the solves.
     const auto start = Clock::now();
-    const Eigen::VectorXd density = sizing_density(surface_curvature, options.density);
     std::vector<char> density_shortened(static_cast<std::size_t>(n), 0);
     // Free boundary vertices (fix_boundary false) stay where the solve put them: their centroid
     // lies inside the surface, and nothing would hold them on the boundary line.

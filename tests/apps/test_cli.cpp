@@ -646,5 +646,15 @@ TEST(CliEnhance, AReferenceThatDoesNotOverlapIsRefusedNamingBothFiles) {
   EXPECT_NE(help.out.find("within 10x the input's"), std::string::npos) << help.out;
 }
 
+// Item 9: an exponent where the density is 0 or inf everywhere (before: accepted, exit 0) is
+// refused by its flag, with its range.
+TEST(CliEnhance, ADensityExponentBeyondTheBoundIsRefused) {
+  test::ScratchDir dir("cli-enhance-exponent");
+  const auto r = run_cli("--quiet enhance " + quoted_data_path("bunny_uniform.off") + " " +
+                         test::quoted(dir.file("out.ply")) + " --density-passes 3 --density-exponent 1e5");
+  EXPECT_EQ(r.exit_code, 1);
+  EXPECT_NE(r.err.find("--density-exponent: 100000 is not in the allowed range ([0, 10])"), std::string::npos) << r.err;
+}
+
 }  // namespace
 }  // namespace vertexflow

@@ -14,6 +14,7 @@
 
 #include <cmath>
 #include <iostream>
+#include <string>
 
 namespace vertexflow {
 namespace {
@@ -144,6 +145,42 @@ TEST(DensityRelaxation, RefusesOptionsOutOfRange) {
   FlowOptions unprojected = with_passes(5);
   unprojected.project_to_input = false;
   EXPECT_THROW(vertex_flow(sphere.V, sphere.F, unprojected), std::invalid_argument);
+}
+
+// Issue 32 item 9: the exponent is bounded where the density stays finite. At 1e5 every density,
+// (0.1 + |k1| + |k2|)^1e5, was 0 (|k1| + |k2| < 0.9 per mean edge length) or inf, which gave a
+// vertex no centroid or a NaN one, without a word.
+TEST(DensityRelaxation, TheExponentIsBoundedWhereTheDensityIsFinite) {
+  const Mesh sphere = test::noisy_scan(test::icosphere(1.0, 3), 0.0, 0.3, 7);
+  for (const double exponent : {1e5, 10.5}) {
+    FlowOptions options = with_passes(3);
+    options.density.exponent = exponent;
+    try {
+      vertex_flow(sphere.V, sphere.F, options);
+      ADD_FAILURE() << "exponent " << exponent << " accepted";
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("density.exponent must be in [0, 10]"), std::string::npos) << e.what();
+    }
+  }
+  // At the bound the passes still move the vertices beyond the flow's result.
+  FlowOptions at_bound = with_passes(3);
+  at_bound.density.exponent = DensityRelaxation::max_exponent;
+  const double difference =
+      (vertex_flow(sphere.V, sphere.F, at_bound).V - vertex_flow(sphere.V, sphere.F).V).rowwise().norm().maxCoeff();
+  std::cout << "[measured] jittered sphere, 3 passes at exponent 10: largest difference from the flow " << difference
+            << "\n";
+  EXPECT_GT(difference, 0.0);
+  // A density that underflows all the same (epsilon 1e-40 on the flat faces of a rounded cube:
+  // 1e-400) is refused by name, not passed over.
+  FlowOptions underflow = at_bound;
+  underflow.density.epsilon = 1e-40;
+  const Mesh cube = test::rounded_cube(1.0, 0.3, 6);
+  try {
+    vertex_flow(cube.V, cube.F, underflow);
+    ADD_FAILURE() << "a density of 0 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("sizing density"), std::string::npos) << e.what();
+  }
 }
 
 // A free boundary (fix_boundary false) moves in the solve but not in the passes, whose
