@@ -94,20 +94,16 @@ TEST(CliAttributes, EnhanceCarriesThemAndEveryDropIsNamed) {
       << remesh.err;
 }
 
-// Every floating-point option of every subcommand, as their --help lists them (CLI11's FLOAT),
-// refuses nan, inf and -inf before anything is read: one line naming the option, exit 1, nothing
-// written (issue 32 item 3: `render --view custom --azimuth nan` wrote a blank PNG with exit 0,
-// and a NaN passed every range check).
-TEST(Cli, EveryFloatingPointOptionRefusesNanAndInfinity) {
-  test::ScratchDir dir("cli-non-finite");
-  const auto input = dir.file("in.obj");
-  std::ofstream(input) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
-  const auto lines_of = [](const std::string& text) {
-    std::vector<std::string> lines;
-    std::istringstream in(text);
-    for (std::string line; std::getline(in, line);) lines.push_back(line);
-    return lines;
-  };
+// The lines of a text.
+std::vector<std::string> lines_of(const std::string& text) {
+  std::vector<std::string> lines;
+  std::istringstream in(text);
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+// The subcommands `vertexflow --help` lists.
+std::vector<std::string> subcommands() {
   std::vector<std::string> commands;
   bool in_subcommands = false;
   for (const std::string& line : lines_of(run_cli("--help").out)) {
@@ -115,6 +111,24 @@ TEST(Cli, EveryFloatingPointOptionRefusesNanAndInfinity) {
     std::smatch m;
     if (in_subcommands && std::regex_match(line, m, std::regex(R"(  ([a-z][a-z-]*)\b.*)"))) commands.push_back(m[1]);
   }
+  return commands;
+}
+
+// A closed tetrahedron in DIR/in.obj, an input every command takes.
+std::filesystem::path tetrahedron_in(const test::ScratchDir& dir) {
+  const auto input = dir.file("in.obj");
+  std::ofstream(input) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
+  return input;
+}
+
+// Every floating-point option of every subcommand, as their --help lists them (CLI11's FLOAT),
+// refuses nan, inf and -inf before anything is read: one line naming the option, exit 1, nothing
+// written (issue 32 item 3: `render --view custom --azimuth nan` wrote a blank PNG with exit 0,
+// and a NaN passed every range check).
+TEST(Cli, EveryFloatingPointOptionRefusesNanAndInfinity) {
+  test::ScratchDir dir("cli-non-finite");
+  const auto input = tetrahedron_in(dir);
+  const std::vector<std::string> commands = subcommands();
   ASSERT_GE(commands.size(), 11u);
   // "  --frame FLOAT x 6", "    --edge-length FLOAT:POSITIVE", "  --weights FLOAT ..."
   const std::regex float_option(R"(\s+(?:-\w,)?(--[\w-]+) FLOAT\S*(?: x (\d+))?.*)");
@@ -164,21 +178,8 @@ TEST(Cli, EveryFloatingPointOptionRefusesNanAndInfinity) {
 // bound of 309 digits and exited 105; `--samples 1e20` and `--lambda abc` "could not convert").
 TEST(Cli, OptionErrorsNameTheOptionAndStateTheRangePlainly) {
   test::ScratchDir dir("cli-option-errors");
-  const auto input = dir.file("in.obj");
-  std::ofstream(input) << "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf 1 3 2\nf 1 2 4\nf 1 4 3\nf 2 3 4\n";
-  const auto lines_of = [](const std::string& text) {
-    std::vector<std::string> lines;
-    std::istringstream in(text);
-    for (std::string line; std::getline(in, line);) lines.push_back(line);
-    return lines;
-  };
-  std::vector<std::string> commands;
-  bool in_subcommands = false;
-  for (const std::string& line : lines_of(run_cli("--help").out)) {
-    if (line == "Subcommands:") in_subcommands = true;
-    std::smatch m;
-    if (in_subcommands && std::regex_match(line, m, std::regex(R"(  ([a-z][a-z-]*)\b.*)"))) commands.push_back(m[1]);
-  }
+  const auto input = tetrahedron_in(dir);
+  const std::vector<std::string> commands = subcommands();
   ASSERT_GE(commands.size(), 11u);
   const std::regex numeric_option(R"(\s+(?:-\w,)?(--[\w-]+) (INT|UINT|FLOAT)(\S*)(?: x (\d+))?.*)");
   const std::regex long_number(R"(\d{13})");
