@@ -1,7 +1,8 @@
 // Distances between triangle meshes (docs/metrics.md, "Shape fidelity").
 //
 // Distance A -> B: points on A (area-uniform samples, plus every vertex and every edge
-// midpoint of A), each measured to the exact closest point on B's triangles. The closest
+// midpoint of A, thinned evenly to a fixed count on large meshes), each measured to the exact
+// closest point on B's triangles. The closest
 // points come from CGAL's AABB tree (a bounding-volume hierarchy over B) with CGAL's exact
 // point-triangle projection, in double precision.
 //
@@ -13,6 +14,11 @@
 //   tessellated. The maximum is taken over all points: vertices and edge midpoints are where
 //   a coarse mesh strays furthest from a fine one, and random samples would miss them. Without
 //   area samples (samples = 0, or every face of A degenerate) mean and RMS are over all points.
+//   On a mesh with more vertices and edges than SamplingOptions::max_vertices_and_midpoints
+//   the maximum is over an even subset of them: an estimate from below, at a fixed cost.
+// - Memory: a tree takes about 68 bytes per face of B (its nodes and one 4-byte face index per
+//   triangle; triangles are read from V and F when visited), plus the copy of V and F unless it
+//   borrows them (DistanceQuery::Borrow).
 // - Determinism: for a given seed the samples are the same on every run and for any number of
 //   threads (they are drawn in one sequential stream), and the parallel queries run in fixed
 //   blocks with sums taken in a fixed order, so every figure is bit-identical for 1 or more
@@ -39,10 +45,16 @@ struct SamplingOptions {
   bool vertices = true;
   /// Also take the midpoint of every edge of A (each undirected edge once).
   bool edge_midpoints = true;
+  /// At most this many vertices and edge midpoints together: above it, an even subset of each
+  /// (in proportion to their counts) is taken, so that the points, their memory and the
+  /// queries stay bounded on large meshes (at 1M vertices there are 4.3M of them). 500,000
+  /// keeps every point of meshes up to about 125k vertices (each of data/ unchanged) and costs
+  /// about 2.5 times the 200,000 area samples' queries. Negative: no limit.
+  Index max_vertices_and_midpoints = 500000;
 };
 
 /// Points on a mesh, in three consecutive blocks: the area-uniform samples, then the vertices,
-/// then the edge midpoints.
+/// then the edge midpoints (those taken, see SamplingOptions::max_vertices_and_midpoints).
 struct SurfaceSamples {
   Vertices points;
   Index num_area_samples = 0;
@@ -52,8 +64,10 @@ struct SurfaceSamples {
 
 /// Samples the surface (V, F) as described by `options`. Area samples are sorted by face
 /// (face order, the order they were drawn within a face) so that neighbouring queries are
-/// close in space. Throws std::invalid_argument if `options.samples` is negative or F indexes
-/// outside V.
+/// close in space; vertices are in index order and edge midpoints in the order of their (lower,
+/// higher) vertex pairs, or when thinned an even subset of each in that order, then sorted
+/// along a Morton curve (for the queries' first guesses). Throws std::invalid_argument if
+/// `options.samples` is negative or F indexes outside V.
 SurfaceSamples sample_surface(const Vertices& V, const Faces& F, const SamplingOptions& options = {});
 
 /// The closest point of a mesh B to a query point.
@@ -71,14 +85,22 @@ struct ClosestPoint {
 /// tree of it (reference_surface.h).
 std::uint64_t distance_trees_built(Index num_faces);
 
-/// Closest-point queries against a fixed mesh B: an AABB tree built once (with CGAL's internal
-/// k-d tree for the first guess), then queried any number of times, from any number of threads.
-/// Holds its own copy of B's triangles.
+/// Closest-point queries against a fixed mesh B: an AABB tree built once, then queried any
+/// number of times, from any number of threads. Holds its own copy of B's vertices and faces,
+/// or borrows the caller's.
 class DistanceQuery {
  public:
   /// Builds the tree over the triangles of (V, F). Throws std::invalid_argument if F is empty
   /// or indexes outside V.
   DistanceQuery(const Vertices& V, const Faces& F);
+  /// Tag of the constructor that borrows the mesh.
+  struct Borrow {};
+  /// The same tree without a copy of V and F (24 bytes per vertex and 12 per face less): they
+  /// are the caller's and must outlive the query unchanged. The answers are the same.
+  DistanceQuery(const Vertices& V, const Faces& F, Borrow);
+  DistanceQuery(Vertices&& V, const Faces& F, Borrow) = delete;
+  DistanceQuery(const Vertices& V, Faces&& F, Borrow) = delete;
+  DistanceQuery(Vertices&& V, Faces&& F, Borrow) = delete;
   ~DistanceQuery();
   DistanceQuery(DistanceQuery&&) noexcept;
   DistanceQuery& operator=(DistanceQuery&&) noexcept;
@@ -102,7 +124,7 @@ class DistanceQuery {
   /// nearest to the previous point) is already within sqrt(at_least) is not searched for.
   [[nodiscard]] double max_squared_distance(const Vertices& P, Index first_row = 0, double at_least = 0) const;
 
-  /// B's vertices and faces (the copy the tree was built from).
+  /// B's vertices and faces (the copy the tree was built from, or the borrowed ones).
   [[nodiscard]] const Vertices& vertices() const;
   [[nodiscard]] const Faces& faces() const;
 

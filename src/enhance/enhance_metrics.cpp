@@ -18,11 +18,12 @@ namespace {
 
 // Two-sided, as issue 16 measures: the mean of both one-sided means, the RMS over both
 // directions, and the Hausdorff distance, in the meshes' units. The reference's tree and samples
-// (the large side) come from the ReferenceSurface, built once for both meshes.
+// (the large side) come from the ReferenceSurface, built once for both meshes; the mesh's own
+// tree borrows its V and F and lives for its one query.
 nlohmann::json distance_to(const Mesh& m, const ReferenceSurface& reference) {
-  const SymmetricDistance d =
-      symmetric_distance(one_sided_distance(sample_surface(m.V, m.F), reference.distance_query()),
-                         one_sided_distance(reference.samples(), DistanceQuery(m.V, m.F)));
+  const DistanceStats to_reference = one_sided_distance(sample_surface(m.V, m.F), reference.distance_query());
+  const SymmetricDistance d = symmetric_distance(
+      to_reference, one_sided_distance(reference.samples(), DistanceQuery(m.V, m.F, DistanceQuery::Borrow{})));
   return {{"mean", d.mean()},
           {"rms", d.rms()},
           {"hausdorff", d.hausdorff},

@@ -9,7 +9,9 @@
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
 
+#include <algorithm>
 #include <cmath>
+#include <optional>
 #include <string>
 
 namespace vertexflow {
@@ -90,25 +92,32 @@ SurfaceCurvatureAtPoints surface_curvature_at(const Vertices& P, const DistanceQ
     throw std::invalid_argument("surface_curvature_at: curvature of " + std::to_string(surface_curvature.k1.size()) +
                                 " vertices for a surface of " + std::to_string(surface.vertices().rows()));
   const Faces& F = surface.faces();
-  const std::vector<ClosestPoint> closest = surface.closest_points(P);
   SurfaceCurvatureAtPoints out;
-  out.tensors.resize(closest.size());
+  out.tensors.resize(static_cast<std::size_t>(P.rows()));
   out.magnitude.resize(P.rows());
   const Eigen::VectorXd magnitude = surface_curvature.absolute_sum();
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, closest.size(), 4096), [&](const auto& range) {
-    for (std::size_t i = range.begin(); i != range.end(); ++i) {
-      const ClosestPoint& c = closest[i];
-      Eigen::Matrix3d K = Eigen::Matrix3d::Zero();
-      double m = 0;
-      for (int k = 0; k < 3; ++k) {
-        const Index v = F(c.face, k);
-        K += c.barycentric[k] * surface_curvature.absolute_tensor(v);
-        m += c.barycentric[k] * magnitude[v];
+  // The closest points in chunks, so that they take 4 MiB rather than 64 bytes per point. A
+  // chunk is a whole number of the queries' blocks (256 points), so the answers are the ones a
+  // single call gives.
+  constexpr Eigen::Index kChunk = 65536;
+  for (Eigen::Index start = 0; start < P.rows(); start += kChunk) {
+    const Eigen::Index n = std::min(kChunk, P.rows() - start);
+    const std::vector<ClosestPoint> closest = surface.closest_points(P.middleRows(start, n));
+    tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, n, 4096), [&](const auto& range) {
+      for (Eigen::Index i = range.begin(); i != range.end(); ++i) {
+        const ClosestPoint& c = closest[static_cast<std::size_t>(i)];
+        Eigen::Matrix3d K = Eigen::Matrix3d::Zero();
+        double m = 0;
+        for (int k = 0; k < 3; ++k) {
+          const Index v = F(c.face, k);
+          K += c.barycentric[k] * surface_curvature.absolute_tensor(v);
+          m += c.barycentric[k] * magnitude[v];
+        }
+        out.tensors[static_cast<std::size_t>(start + i)] = K;
+        out.magnitude[start + i] = m;
       }
-      out.tensors[i] = K;
-      out.magnitude[static_cast<Eigen::Index>(i)] = m;
-    }
-  });
+    });
+  }
   return out;
 }
 
@@ -137,14 +146,19 @@ MeshComparison compare_meshes(const Mesh& result, const Mesh& input, const Mesh*
   c.has_reference = reference != nullptr;
   c.length_scale = bounding_box(reference ? reference->V : input.V).diagonal();
 
-  // Everything that does not depend on anything else, at once: tree builds and sampling are
-  // serial inside, the curvature estimator parallel. Each mesh is sampled once and each tree
-  // built once; the result's samples serve both the input and the reference.
-  std::optional<DistanceQuery> result_query, input_query, reference_query;
+  // Memory (issue 29): one distance tree at a time, each over the mesh's own V and F (not a
+  // copy) and freed after its queries; samples bounded (SamplingOptions), and each surface
+  // curvature at the vertices used and freed before the next. Every figure is as when all were
+  // built at once: each depends only on its samples and the tree it queries.
+  //
+  // First, at once: each mesh's samples (one draw each: the result's serve the input and the
+  // reference), the curvatures not given, and the first tree (the input's).
+  using Borrow = DistanceQuery::Borrow;
+  std::optional<DistanceQuery> query;
   SurfaceSamples result_samples, input_samples, reference_samples;
   Curvature own_result_curvature, own_input_curvature, own_reference_curvature;
   tbb::parallel_invoke(
-      [&] { result_query.emplace(result.V, result.F); }, [&] { input_query.emplace(input.V, input.F); },
+      [&] { query.emplace(input.V, input.F, Borrow{}); },
       [&] { result_samples = sample_surface(result.V, result.F, options.sampling); },
       [&] { input_samples = sample_surface(input.V, input.F, options.sampling); },
       [&] {
@@ -157,8 +171,7 @@ MeshComparison compare_meshes(const Mesh& result, const Mesh& input, const Mesh*
       },
       [&] {
         if (!reference) return;
-        tbb::parallel_invoke([&] { reference_query.emplace(reference->V, reference->F); },
-                             [&] { reference_samples = sample_surface(reference->V, reference->F, options.sampling); },
+        tbb::parallel_invoke([&] { reference_samples = sample_surface(reference->V, reference->F, options.sampling); },
                              [&] {
                                if (!precomputed.reference.curvature)
                                  own_reference_curvature = principal_curvatures(reference->V, reference->F,
@@ -169,29 +182,46 @@ MeshComparison compare_meshes(const Mesh& result, const Mesh& input, const Mesh*
   const Curvature& input_curvature = curvature_of(precomputed.input, own_input_curvature);
   const Curvature& reference_curvature = curvature_of(precomputed.reference, own_reference_curvature);
 
-  // Shape fidelity.
-  c.result_input = symmetric_distance(one_sided_distance(result_samples, *input_query),
-                                      one_sided_distance(input_samples, *result_query));
-  if (reference) {
-    c.result_reference = symmetric_distance(one_sided_distance(result_samples, *reference_query),
-                                            one_sided_distance(reference_samples, *result_query));
-    c.input_reference = symmetric_distance(one_sided_distance(input_samples, *reference_query),
-                                           one_sided_distance(reference_samples, *input_query));
-  }
+  // Approximation uniformity and redistribution of one mesh from the surface's curvature at its
+  // vertices, which are then freed.
+  const auto uniformity = [](const Mesh& mesh, const Topology& topology, const SurfaceCurvatureAtPoints& at,
+                             EdgeErrorStats& edge_error, double& rho) {
+    edge_error = edge_error_stats(mesh.V, topology, at.tensors);
+    rho = redistribution_rho(at.magnitude, mesh.V, mesh.F);
+  };
 
-  // The surface's curvature at both meshes' vertices.
-  SurfaceCurvatureAtPoints at_input, at_result;
+  // The input's tree: result -> input, reference -> input, and without a reference the input
+  // surface's curvature at the result's vertices.
+  const DistanceStats result_to_input = one_sided_distance(result_samples, *query);
+  DistanceStats reference_to_input;
   if (reference) {
-    at_input = surface_curvature_at(input.V, *reference_query, reference_curvature);
-    at_result = surface_curvature_at(result.V, *reference_query, reference_curvature);
+    reference_to_input = one_sided_distance(reference_samples, *query);
   } else {
-    at_input = own_curvature(input_curvature);
-    at_result = surface_curvature_at(result.V, *input_query, input_curvature);
+    uniformity(result, result_topology, surface_curvature_at(result.V, *query, input_curvature), c.edge_error_result,
+               c.redistribution_rho_result);
+    uniformity(input, input_topology, own_curvature(input_curvature), c.edge_error_input, c.redistribution_rho_input);
   }
-  c.edge_error_input = edge_error_stats(input.V, input_topology, at_input.tensors);
-  c.edge_error_result = edge_error_stats(result.V, result_topology, at_result.tensors);
-  c.redistribution_rho_input = redistribution_rho(at_input.magnitude, input.V, input.F);
-  c.redistribution_rho_result = redistribution_rho(at_result.magnitude, result.V, result.F);
+  query.reset();
+
+  // The result's tree: input -> result, reference -> result.
+  query.emplace(result.V, result.F, Borrow{});
+  c.result_input = symmetric_distance(result_to_input, one_sided_distance(input_samples, *query));
+  DistanceStats reference_to_result;
+  if (reference) reference_to_result = one_sided_distance(reference_samples, *query);
+  query.reset();
+
+  // The reference's tree: result -> reference, input -> reference, and the reference's
+  // curvature at both meshes' vertices.
+  if (reference) {
+    query.emplace(reference->V, reference->F, Borrow{});
+    c.result_reference = symmetric_distance(one_sided_distance(result_samples, *query), reference_to_result);
+    c.input_reference = symmetric_distance(one_sided_distance(input_samples, *query), reference_to_input);
+    uniformity(input, input_topology, surface_curvature_at(input.V, *query, reference_curvature), c.edge_error_input,
+               c.redistribution_rho_input);
+    uniformity(result, result_topology, surface_curvature_at(result.V, *query, reference_curvature),
+               c.edge_error_result, c.redistribution_rho_result);
+    query.reset();
+  }
   c.abs_mean_curvature_input = mean_curvature_percentiles(input_curvature);
   c.abs_mean_curvature_result = mean_curvature_percentiles(result_curvature);
 

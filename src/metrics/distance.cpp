@@ -4,8 +4,9 @@
 
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
-#include <CGAL/AABB_triangle_primitive.h>
 #include <CGAL/Simple_cartesian.h>
+
+#include <boost/iterator/counting_iterator.hpp>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -29,15 +30,45 @@ namespace {
 // interval filtering of the exact-predicates kernels, which buys nothing here.
 using Kernel = CGAL::Simple_cartesian<double>;
 using Triangle = Kernel::Triangle_3;
-using TriangleIterator = std::vector<Triangle>::const_iterator;
-// CacheDatum false: a primitive is an iterator into DistanceQuery's triangle array, not a copy
-// of its triangle. The tree's build sorts primitives, and with the copies (80 bytes each) it
-// took twice as long: 1.52 s against 0.75 s for 1.1M triangles (bunny.off subdivided). Queries
-// read the triangle from the contiguous array instead, about 10% slower (bench_compare, with
-// the k-d tree below removed too: build 319 -> 174 ms, 200k queries 374 -> 415 ms, the whole
-// two-sided distance 1307 -> 1144 ms).
-using Primitive = CGAL::AABB_triangle_primitive<Kernel, TriangleIterator, CGAL::Tag_false>;
-using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, Primitive>>;
+
+// The mesh a tree is over (not owned): the primitives' shared data.
+struct MeshFaces {
+  const Vertices* V = nullptr;
+  const Faces* F = nullptr;
+  [[nodiscard]] Kernel::Point_3 corner(Index f, int k) const {
+    const auto p = V->row((*F)(f, k));
+    return {p[0], p[1], p[2]};
+  }
+  [[nodiscard]] Triangle triangle(Index f) const { return {corner(f, 0), corner(f, 1), corner(f, 2)}; }
+};
+
+// A primitive is a face index; its triangle is read from V and F when the tree needs it. A
+// tree of CGAL's AABB_triangle_primitive over an array of Triangle_3 held that array (72 bytes
+// per face) and an iterator per primitive besides the copy of V and F: 390 bytes per vertex
+// with the nodes, against about 136 now, and the builds sort 4-byte primitives. The reference
+// point (the first corner, as AABB_triangle_primitive's) and the boxes are the same, so the
+// tree and every answer are too. (Primitives holding their triangle, CacheDatum true, made the
+// build twice as slow: 80-byte primitives to sort.)
+class FacePrimitive {
+ public:
+  using Id = Index;
+  using Point = Kernel::Point_3;
+  using Datum = Triangle;
+  using Shared_data = MeshFaces;
+
+  FacePrimitive() = default;
+  template <class Iterator>
+  FacePrimitive(Iterator face, const MeshFaces& /*mesh*/) : face_(static_cast<Index>(*face)) {}
+
+  [[nodiscard]] Id id() const { return face_; }
+  [[nodiscard]] Datum datum(const MeshFaces& mesh) const { return mesh.triangle(face_); }
+  [[nodiscard]] Point reference_point(const MeshFaces& mesh) const { return mesh.corner(face_, 0); }
+  static MeshFaces construct_shared_data(const MeshFaces& mesh) { return mesh; }
+
+ private:
+  Index face_ = -1;
+};
+using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, FacePrimitive>>;
 
 // Squared distance from p to an axis-aligned box (0 inside).
 inline double squared_distance_to_box(const Kernel::Point_3& p, const CGAL::Bbox_3& box) {
@@ -60,13 +91,13 @@ class ClosestPointTraits {
  public:
   using Priority = double;  // minus the squared distance to the box: nearer first
 
-  ClosestPointTraits(const Kernel::Point_3& query, const Tree::Point_and_primitive_id& hint)
-      : best_(hint), best_d2_(CGAL::squared_distance(query, hint.first)) {}
+  ClosestPointTraits(const Kernel::Point_3& query, const Tree::Point_and_primitive_id& hint, const MeshFaces& mesh)
+      : best_(hint), best_d2_(CGAL::squared_distance(query, hint.first)), mesh_(mesh) {}
 
   [[nodiscard]] bool go_further() const { return true; }
 
-  void intersection(const Kernel::Point_3& query, const Primitive& primitive) {
-    const Triangle& t = primitive.datum();
+  void intersection(const Kernel::Point_3& query, const FacePrimitive& primitive) {
+    const Triangle t = mesh_.triangle(primitive.id());
     if (squared_distance_to_box(query, t.bbox()) >= best_d2_) return;
     const Kernel::Point_3 closest = Kernel().construct_projected_point_3_object()(t, query);
     const double d2 = CGAL::squared_distance(query, closest);
@@ -93,6 +124,7 @@ class ClosestPointTraits {
  private:
   Tree::Point_and_primitive_id best_;
   double best_d2_;
+  const MeshFaces& mesh_;
 };
 
 // Queries run in blocks of this many points. A block's first query starts from the guess of
@@ -136,6 +168,41 @@ Eigen::Vector3d barycentric(const Eigen::Vector3d& q, const Eigen::Vector3d& a, 
   return db <= dc ? Eigen::Vector3d(0, 1, 0) : Eigen::Vector3d(0, 0, 1);
 }
 
+// Spreads the low 21 bits of x to every third bit (a Morton code's one axis).
+std::uint64_t spread_bits(std::uint64_t x) {
+  x &= 0x1fffff;
+  x = (x | x << 32) & 0x1f00000000ffffULL;
+  x = (x | x << 16) & 0x1f0000ff0000ffULL;
+  x = (x | x << 8) & 0x100f00f00f00f00fULL;
+  x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
+  x = (x | x << 2) & 0x1249249249249249ULL;
+  return x;
+}
+
+// Sorts the rows [first, first + count) of P along a Morton curve in P's bounding box (ties by
+// row, so the order is fixed). For a thinned subset of vertices or midpoints: in index order
+// consecutive points are far apart, so each query's first guess (the previous answer's
+// triangle) is poor; in this order the maximum's queries took 0.82 s of CPU instead of 2.09 s
+// (500,000 points of the 1M-vertex armadillo).
+void sort_along_morton_curve(Vertices& P, std::int64_t first, std::int64_t count) {
+  if (count < 2) return;
+  auto rows = P.middleRows(first, count);
+  const Eigen::RowVector3d low = rows.colwise().minCoeff(), high = rows.colwise().maxCoeff();
+  const Eigen::RowVector3d scale = (high - low).cwiseMax(1e-300).cwiseInverse() * 2097151.0;
+  // A cell of the 2^21 grid; a non-finite coordinate goes to cell 0 (its order is then arbitrary
+  // but fixed).
+  const auto cell = [](double t) { return t >= 0 ? static_cast<std::uint64_t>(std::min(t, 2097151.0)) : 0; };
+  std::vector<std::pair<std::uint64_t, std::int64_t>> key(static_cast<std::size_t>(count));
+  for (std::int64_t i = 0; i < count; ++i) {
+    const Eigen::RowVector3d t = (rows.row(i) - low).cwiseProduct(scale);
+    key[static_cast<std::size_t>(i)] = {
+        spread_bits(cell(t.x())) | spread_bits(cell(t.y())) << 1 | spread_bits(cell(t.z())) << 2, i};
+  }
+  std::sort(key.begin(), key.end());
+  const Vertices copy = rows;
+  for (std::int64_t i = 0; i < count; ++i) rows.row(i) = copy.row(key[static_cast<std::size_t>(i)].second);
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -148,9 +215,13 @@ SurfaceSamples sample_surface(const Vertices& V, const Faces& F, const SamplingO
 
   // Cumulative face areas; a face is drawn when a uniform number in [0, total) falls in its
   // interval, so zero-area faces are never drawn.
+  // (The areas in parallel, their sum in face order: the same bits as one loop.)
   std::vector<double> cumulative(static_cast<std::size_t>(nf));
+  tbb::parallel_for(tbb::blocked_range<Index>(0, nf, 4096), [&](const tbb::blocked_range<Index>& r) {
+    for (Index f = r.begin(); f != r.end(); ++f) cumulative[static_cast<std::size_t>(f)] = face_area(V, F, f);
+  });
   double total = 0;
-  for (Index f = 0; f < nf; ++f) cumulative[static_cast<std::size_t>(f)] = total += face_area(V, F, f);
+  for (double& c : cumulative) c = total += c;
 
   SurfaceSamples s;
   s.num_area_samples = total > 0 ? options.samples : 0;
@@ -169,8 +240,19 @@ SurfaceSamples sample_surface(const Vertices& V, const Faces& F, const SamplingO
     tbb::parallel_sort(edges.begin(), edges.end());
     edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
   }
-  s.num_vertices = options.vertices ? static_cast<Index>(V.rows()) : 0;
-  s.num_edge_midpoints = static_cast<Index>(edges.size());
+  // Thinning (SamplingOptions::max_vertices_and_midpoints): an even subset of each block, the
+  // blocks in proportion to their sizes; take(k, n, j) is the j-th of k evenly spaced of n.
+  const std::int64_t all_vertices = options.vertices ? V.rows() : 0;
+  const auto all_midpoints = static_cast<std::int64_t>(edges.size());
+  std::int64_t vertices_taken = all_vertices, midpoints_taken = all_midpoints;
+  const std::int64_t cap = options.max_vertices_and_midpoints;
+  if (cap >= 0 && all_vertices + all_midpoints > cap) {
+    vertices_taken = all_vertices * cap / (all_vertices + all_midpoints);
+    midpoints_taken = cap - vertices_taken;
+  }
+  const auto take = [](std::int64_t k, std::int64_t n, std::int64_t j) { return k == n ? j : j * n / k; };
+  s.num_vertices = static_cast<Index>(vertices_taken);
+  s.num_edge_midpoints = static_cast<Index>(midpoints_taken);
   s.points.resize(std::int64_t{s.num_area_samples} + s.num_vertices + s.num_edge_midpoints, 3);
 
   if (s.num_area_samples > 0) {
@@ -209,12 +291,16 @@ SurfaceSamples sample_surface(const Vertices& V, const Faces& F, const SamplingO
       s.points.row(offset[static_cast<std::size_t>(f)]++) = p0 + a * (V.row(F(f, 1)) - p0) + b * (V.row(F(f, 2)) - p0);
     }
   }
-  if (s.num_vertices > 0) s.points.middleRows(s.num_area_samples, s.num_vertices) = V;
+  for (std::int64_t k = 0; k < vertices_taken; ++k)
+    s.points.row(s.num_area_samples + k) = V.row(take(vertices_taken, all_vertices, k));
   const std::int64_t first_midpoint = std::int64_t{s.num_area_samples} + s.num_vertices;
-  for (std::size_t e = 0; e < edges.size(); ++e) {
-    const auto i = static_cast<Index>(edges[e] >> 32), j = static_cast<Index>(edges[e] & 0xffffffffu);
-    s.points.row(first_midpoint + static_cast<std::int64_t>(e)) = 0.5 * (V.row(i) + V.row(j));
+  for (std::int64_t k = 0; k < midpoints_taken; ++k) {
+    const std::uint64_t e = edges[static_cast<std::size_t>(take(midpoints_taken, all_midpoints, k))];
+    const auto i = static_cast<Index>(e >> 32), j = static_cast<Index>(e & 0xffffffffu);
+    s.points.row(first_midpoint + k) = 0.5 * (V.row(i) + V.row(j));
   }
+  if (vertices_taken < all_vertices) sort_along_morton_curve(s.points, s.num_area_samples, vertices_taken);
+  if (midpoints_taken < all_midpoints) sort_along_morton_curve(s.points, first_midpoint, midpoints_taken);
   return s;
 }
 
@@ -229,14 +315,13 @@ SurfaceSamples sample_surface(const Vertices& V, const Faces& F, const SamplingO
 constexpr Index kTwoTreesFrom = 200000;
 
 struct DistanceQuery::Impl {
-  Vertices V;
-  Faces F;
-  std::vector<Triangle> triangles;  // in tree order: face_of[k] is the face of triangles[k]
-  std::vector<Index> face_of;       // empty: triangles[k] is face k
-  std::vector<Tree> trees;          // over consecutive ranges of triangles
+  Vertices own_V;  // the copy, unless borrowed
+  Faces own_F;
+  MeshFaces mesh;           // own_V and own_F, or the caller's
+  std::vector<Tree> trees;  // over two halves of the faces (kTwoTreesFrom), or all of them
 
   Tree::Point_and_primitive_id closest(const Kernel::Point_3& q, const Tree::Point_and_primitive_id& hint) const {
-    ClosestPointTraits traits(q, hint);
+    ClosestPointTraits traits(q, hint, mesh);
     if (trees.size() == 1) {
       trees[0].traversal_with_priority(q, traits);
     } else {
@@ -248,10 +333,9 @@ struct DistanceQuery::Impl {
     return traits.result();
   }
   [[nodiscard]] Tree::Point_and_primitive_id any_hint(const Kernel::Point_3& q) const { return trees[0].best_hint(q); }
-  [[nodiscard]] Index face(TriangleIterator t) const {
-    const auto k = static_cast<std::size_t>(t - triangles.begin());
-    return face_of.empty() ? static_cast<Index>(k) : face_of[k];
-  }
+
+  // Counts the tree (distance_trees_built) and builds it over (V, F), which must outlive it.
+  void build_trees(const Vertices& V, const Faces& F);
 
   // Runs fn(point index, query point, CGAL answer) for the rows [first, last) of P, in fixed
   // blocks (see kQueryBlock). With skip_at_most >= 0, a point whose first guess is already
@@ -272,7 +356,7 @@ struct DistanceQuery::Impl {
               } else {
                 // Start from the closest point of the previous answer's triangle: a tighter
                 // first bound than the previous closest point itself.
-                hint.first = Kernel().construct_projected_point_3_object()(*hint.second, q);
+                hint.first = Kernel().construct_projected_point_3_object()(mesh.triangle(hint.second), q);
               }
               if (skip_at_most >= 0 && CGAL::squared_distance(q, hint.first) <= skip_at_most) continue;
               hint = closest(q, hint);
@@ -292,7 +376,9 @@ struct DistanceQuery::Impl {
     ClosestPoint c;
     c.point = to_eigen(answer.first);
     c.squared_distance = CGAL::squared_distance(q, answer.first);
-    c.face = face(answer.second);
+    c.face = answer.second;
+    const Vertices& V = *mesh.V;
+    const Faces& F = *mesh.F;
     c.barycentric = barycentric(c.point, V.row(F(c.face, 0)), V.row(F(c.face, 1)), V.row(F(c.face, 2)));
     return c;
   }
@@ -317,61 +403,60 @@ std::uint64_t distance_trees_built(Index num_faces) {
 
 DistanceQuery::DistanceQuery(const Vertices& V, const Faces& F) : impl_(std::make_unique<Impl>()) {
   if (F.rows() == 0) throw std::invalid_argument("DistanceQuery: the mesh has no faces");
+  check_indices(V, F, "DistanceQuery");
+  impl_->own_V = V;
+  impl_->own_F = F;
+  impl_->build_trees(impl_->own_V, impl_->own_F);
+}
+
+DistanceQuery::DistanceQuery(const Vertices& V, const Faces& F, Borrow) : impl_(std::make_unique<Impl>()) {
+  if (F.rows() == 0) throw std::invalid_argument("DistanceQuery: the mesh has no faces");
+  check_indices(V, F, "DistanceQuery");
+  impl_->build_trees(V, F);
+}
+
+void DistanceQuery::Impl::build_trees(const Vertices& V, const Faces& F) {
   {
     const std::lock_guard lock(trees_mutex);
     ++trees_by_size()[static_cast<Index>(F.rows())];
   }
-  check_indices(V, F, "DistanceQuery");
-  impl_->V = V;
-  impl_->F = F;
+  mesh = {&V, &F};
   const Index nf = static_cast<Index>(F.rows());
-  const auto make_triangle = [&](Index f) {
-    return Triangle(to_cgal(V.row(F(f, 0))), to_cgal(V.row(F(f, 1))), to_cgal(V.row(F(f, 2))));
-  };
-  impl_->triangles.resize(static_cast<std::size_t>(nf));
-  Index first_half = nf;
-  if (nf >= kTwoTreesFrom) {
-    // The median split (kTwoTreesFrom), ties broken by face index.
-    const Eigen::RowVector3d low = V.colwise().minCoeff(), high = V.colwise().maxCoeff();
-    Eigen::Index axis = 0;
-    (high - low).maxCoeff(&axis);
-    std::vector<double> key(static_cast<std::size_t>(nf));
-    tbb::parallel_for(tbb::blocked_range<Index>(0, nf), [&](const tbb::blocked_range<Index>& r) {
-      for (Index f = r.begin(); f != r.end(); ++f)
-        key[static_cast<std::size_t>(f)] = V(F(f, 0), axis) + V(F(f, 1), axis) + V(F(f, 2), axis);
-    });
-    impl_->face_of.resize(static_cast<std::size_t>(nf));
-    std::iota(impl_->face_of.begin(), impl_->face_of.end(), Index{0});
-    first_half = nf / 2;
-    std::nth_element(impl_->face_of.begin(), impl_->face_of.begin() + first_half, impl_->face_of.end(),
-                     [&](Index a, Index b) {
-                       const double ka = key[static_cast<std::size_t>(a)], kb = key[static_cast<std::size_t>(b)];
-                       return ka < kb || (ka == kb && a < b);
-                     });
-  }
-  tbb::parallel_for(tbb::blocked_range<Index>(0, nf), [&](const tbb::blocked_range<Index>& r) {
-    for (Index k = r.begin(); k != r.end(); ++k)
-      impl_->triangles[static_cast<std::size_t>(k)] =
-          make_triangle(impl_->face_of.empty() ? k : impl_->face_of[static_cast<std::size_t>(k)]);
-  });
-  const auto begin = impl_->triangles.cbegin();
-  const auto split = begin + first_half;
-  impl_->trees.resize(split == impl_->triangles.cend() ? 1 : 2);
   // No k-d tree of reference points for hints (CGAL builds one by default, lazily on the first
   // query, serialising the threads): queries run in blocks where each point starts from the
   // previous point's answer, so only a block's first query would use it. It cost 0.8 s of the
   // 2.3 s build for 1.1M triangles.
-  const auto build = [](Tree& tree, TriangleIterator first, TriangleIterator last) {
-    tree.insert(first, last);
+  const auto build_tree = [this](Tree& tree, auto first, auto last) {
+    tree.insert(first, last, mesh);
     tree.do_not_accelerate_distance_queries();
     tree.build();
   };
-  if (impl_->trees.size() == 1) {
-    build(impl_->trees[0], begin, impl_->triangles.cend());
-  } else {
-    tbb::parallel_invoke([&] { build(impl_->trees[0], begin, split); },
-                         [&] { build(impl_->trees[1], split, impl_->triangles.cend()); });
+  if (nf < kTwoTreesFrom) {
+    trees.resize(1);
+    build_tree(trees[0], boost::counting_iterator<Index>(0), boost::counting_iterator<Index>(nf));
+    return;
   }
+  // The median split (kTwoTreesFrom), ties broken by face index.
+  const Eigen::RowVector3d low = V.colwise().minCoeff(), high = V.colwise().maxCoeff();
+  Eigen::Index axis = 0;
+  (high - low).maxCoeff(&axis);
+  std::vector<double> key(static_cast<std::size_t>(nf));
+  tbb::parallel_for(tbb::blocked_range<Index>(0, nf), [&](const tbb::blocked_range<Index>& r) {
+    for (Index f = r.begin(); f != r.end(); ++f)
+      key[static_cast<std::size_t>(f)] = V(F(f, 0), axis) + V(F(f, 1), axis) + V(F(f, 2), axis);
+  });
+  std::vector<Index> face_of(static_cast<std::size_t>(nf));
+  std::iota(face_of.begin(), face_of.end(), Index{0});
+  const auto split = face_of.begin() + nf / 2;
+  std::nth_element(face_of.begin(), split, face_of.end(), [&](Index a, Index b) {
+    const double ka = key[static_cast<std::size_t>(a)], kb = key[static_cast<std::size_t>(b)];
+    return ka < kb || (ka == kb && a < b);
+  });
+  std::vector<double>().swap(key);
+  trees.resize(2);
+  const std::vector<Index>& order = face_of;
+  tbb::parallel_invoke([&] { build_tree(trees[0], order.begin(), order.begin() + nf / 2); },
+                       [&] { build_tree(trees[1], order.begin() + nf / 2, order.end()); });
 }
 
 DistanceQuery::~DistanceQuery() = default;
@@ -379,10 +464,10 @@ DistanceQuery::DistanceQuery(DistanceQuery&&) noexcept = default;
 DistanceQuery& DistanceQuery::operator=(DistanceQuery&&) noexcept = default;
 
 const Vertices& DistanceQuery::vertices() const {
-  return impl_->V;
+  return *impl_->mesh.V;
 }
 const Faces& DistanceQuery::faces() const {
-  return impl_->F;
+  return *impl_->mesh.F;
 }
 
 ClosestPoint DistanceQuery::closest_point(const Eigen::Vector3d& p) const {
@@ -448,7 +533,7 @@ DistanceStats one_sided_distance(const SurfaceSamples& a, const DistanceQuery& b
 
 DistanceStats one_sided_distance(const Vertices& VA, const Faces& FA, const Vertices& VB, const Faces& FB,
                                  const SamplingOptions& options) {
-  const DistanceQuery b(VB, FB);
+  const DistanceQuery b(VB, FB, DistanceQuery::Borrow{});
   return one_sided_distance(sample_surface(VA, FA, options), b);
 }
 
@@ -458,11 +543,18 @@ SymmetricDistance symmetric_distance(const DistanceStats& a_to_b, const Distance
 
 SymmetricDistance symmetric_distance(const Vertices& VA, const Faces& FA, const Vertices& VB, const Faces& FB,
                                      const SamplingOptions& options) {
-  // Both directions at once: the tree builds and the sampling are serial, so this keeps both
-  // cores busy during them. Each direction's figures do not depend on the schedule.
+  // Small meshes: both directions at once, as their tree builds and sampling are serial. Large
+  // ones: one after the other, so that one tree is alive at a time (their builds are parallel,
+  // kTwoTreesFrom). Each direction's figures do not depend on the schedule.
   DistanceStats a_to_b, b_to_a;
-  tbb::parallel_invoke([&] { a_to_b = one_sided_distance(VA, FA, VB, FB, options); },
-                       [&] { b_to_a = one_sided_distance(VB, FB, VA, FA, options); });
+  const auto a_to_b_task = [&] { a_to_b = one_sided_distance(VA, FA, VB, FB, options); };
+  const auto b_to_a_task = [&] { b_to_a = one_sided_distance(VB, FB, VA, FA, options); };
+  if (FA.rows() < kTwoTreesFrom && FB.rows() < kTwoTreesFrom) {
+    tbb::parallel_invoke(a_to_b_task, b_to_a_task);
+  } else {
+    a_to_b_task();
+    b_to_a_task();
+  }
   return symmetric_distance(a_to_b, b_to_a);
 }
 

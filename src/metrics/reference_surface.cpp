@@ -17,7 +17,7 @@ struct ReferenceSurface::Impl {
   std::atomic<int> trees_built{0};
   std::mutex samples_mutex;
   // std::map: its nodes do not move, so a returned reference stays valid as others are added.
-  std::map<std::tuple<Index, std::uint64_t, bool, bool>, SurfaceSamples> samples;
+  std::map<std::tuple<Index, std::uint64_t, bool, bool, Index>, SurfaceSamples> samples;
 };
 
 ReferenceSurface::ReferenceSurface(Vertices V, Faces F, std::string name) : impl_(std::make_unique<Impl>()) {
@@ -45,14 +45,16 @@ const std::string& ReferenceSurface::name() const {
 
 const DistanceQuery& ReferenceSurface::distance_query() const {
   std::call_once(impl_->tree_once, [this] {
-    impl_->tree = std::make_unique<DistanceQuery>(impl_->V, impl_->F);
+    // Over the reference's own V and F, which live as long as the tree: no second copy.
+    impl_->tree = std::make_unique<DistanceQuery>(impl_->V, impl_->F, DistanceQuery::Borrow{});
     ++impl_->trees_built;
   });
   return *impl_->tree;
 }
 
 const SurfaceSamples& ReferenceSurface::samples(const SamplingOptions& options) const {
-  const auto key = std::make_tuple(options.samples, options.seed, options.vertices, options.edge_midpoints);
+  const auto key = std::make_tuple(options.samples, options.seed, options.vertices, options.edge_midpoints,
+                                   options.max_vertices_and_midpoints);
   {
     const std::lock_guard lock(impl_->samples_mutex);
     const auto it = impl_->samples.find(key);

@@ -367,5 +367,20 @@ TEST(CompareMeshes, SameFiguresForOneAndTwoThreads) {
   EXPECT_GT(c[0].result_input.a_to_b.mean, 0.0);
 }
 
+// Each mesh's tree is built once, also with a reference (the trees are built one after the
+// other, each freed after its queries, issue 29).
+TEST(CompareMeshes, BuildsOneTreePerMesh) {
+  const Mesh input = test::icosphere(1.0, 3);  // 1280 faces
+  Mesh result = input;
+  result.V *= 1.001;
+  const Mesh reference = test::icosphere(1.0, 4);  // 5120 faces
+  const std::uint64_t before = distance_trees_built(1280), before_reference = distance_trees_built(5120);
+  const MeshComparison c = compare_meshes(result, input, &reference, few_samples(2000));
+  EXPECT_EQ(distance_trees_built(1280) - before, 2u);  // the input's and the result's
+  EXPECT_EQ(distance_trees_built(5120) - before_reference, 1u);
+  EXPECT_GT(c.result_input.hausdorff, 0.0);
+  EXPECT_TRUE(c.result_reference.has_value());
+}
+
 }  // namespace
 }  // namespace vertexflow

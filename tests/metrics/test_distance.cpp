@@ -9,6 +9,8 @@
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <random>
 
@@ -133,6 +135,26 @@ TEST(DistanceQuery, MatchesBruteForceOnALargeMeshOfTwoTrees) {
   }
 }
 
+// A tree that borrows the caller's V and F answers as one over its own copy, for one tree and
+// for the two of a large mesh, and names the caller's arrays as its mesh.
+TEST(DistanceQuery, BorrowedMeshGivesTheSameAnswers) {
+  for (const Mesh& mesh : {test::icosphere(1.0, 3), test::torus(1.0, 0.3, 500, 201)}) {
+    const DistanceQuery copied(mesh.V, mesh.F);
+    const DistanceQuery borrowed(mesh.V, mesh.F, DistanceQuery::Borrow{});
+    EXPECT_EQ(&borrowed.vertices(), &mesh.V);
+    EXPECT_EQ(&borrowed.faces(), &mesh.F);
+    EXPECT_NE(&copied.vertices(), &mesh.V);
+    const Vertices P = query_points(mesh, 3000, 11);
+    const std::vector<ClosestPoint> a = copied.closest_points(P), b = borrowed.closest_points(P);
+    for (std::size_t i = 0; i < a.size(); ++i) {
+      ASSERT_EQ(a[i].face, b[i].face) << i;
+      ASSERT_EQ(a[i].point, b[i].point) << i;
+      ASSERT_EQ(a[i].barycentric, b[i].barycentric) << i;
+    }
+    EXPECT_EQ(copied.max_squared_distance(P), borrowed.max_squared_distance(P));
+  }
+}
+
 TEST(DistanceQuery, DegenerateTriangleIsItsLongestEdge) {
   Mesh line;
   line.V.resize(3, 3);
@@ -252,6 +274,49 @@ TEST(SampleSurface, VerticesAndEdgeMidpointsFollowTheSamples) {
   options.vertices = false;
   options.edge_midpoints = false;
   EXPECT_EQ(sample_surface(mesh.V, mesh.F, options).points.rows(), 100);
+}
+
+// Above max_vertices_and_midpoints, an even subset of the vertices and of the edge midpoints
+// (in proportion) is taken, in their order; at or below it, all of them, as without a limit.
+TEST(SampleSurface, ThinsVerticesAndMidpointsToTheCap) {
+  const Mesh mesh = test::torus(1.0, 0.3, 40, 20);  // 800 vertices, 2400 edges
+  SamplingOptions options;
+  options.samples = 100;
+  options.max_vertices_and_midpoints = -1;
+  const SurfaceSamples all = sample_surface(mesh.V, mesh.F, options);
+  ASSERT_EQ(all.num_vertices, 800);
+  ASSERT_EQ(all.num_edge_midpoints, 2400);
+  options.max_vertices_and_midpoints = 3200;
+  EXPECT_EQ(sample_surface(mesh.V, mesh.F, options).points, all.points);
+
+  options.max_vertices_and_midpoints = 1000;
+  const SurfaceSamples s = sample_surface(mesh.V, mesh.F, options);
+  EXPECT_EQ(s.num_area_samples, 100);
+  EXPECT_EQ(s.num_vertices, 250);  // 1000 * 800 / 3200
+  EXPECT_EQ(s.num_edge_midpoints, 750);
+  ASSERT_EQ(s.points.rows(), 1100);
+  EXPECT_EQ(s.points.topRows(100), all.points.topRows(100));
+  // Evenly spaced (vertex k is vertex 3.2 k rounded down, midpoint k midpoint 3.2 k), each
+  // block reordered along a space-filling curve.
+  const auto sorted_rows = [](const Vertices& P) {
+    std::vector<std::array<double, 3>> rows;
+    for (Index i = 0; i < P.rows(); ++i) rows.push_back({P(i, 0), P(i, 1), P(i, 2)});
+    std::sort(rows.begin(), rows.end());
+    return rows;
+  };
+  Vertices vertices(250, 3), midpoints(750, 3);
+  for (Index k = 0; k < 250; ++k) vertices.row(k) = mesh.V.row(k * 800 / 250);
+  for (Index k = 0; k < 750; ++k) midpoints.row(k) = all.points.row(900 + k * 2400 / 750);
+  EXPECT_EQ(sorted_rows(s.points.middleRows(100, 250)), sorted_rows(vertices));
+  EXPECT_EQ(sorted_rows(s.points.middleRows(350, 750)), sorted_rows(midpoints));
+  EXPECT_NE(s.points.middleRows(100, 250), vertices);  // reordered
+  // The order is fixed (for the thread-count independence of the figures).
+  EXPECT_EQ(sample_surface(mesh.V, mesh.F, options).points, s.points);
+
+  options.max_vertices_and_midpoints = 0;
+  EXPECT_EQ(sample_surface(mesh.V, mesh.F, options).points.rows(), 100);
+  // The default keeps every point of a mesh this size.
+  EXPECT_EQ(sample_surface(mesh.V, mesh.F, SamplingOptions{}).num_edge_midpoints, 2400);
 }
 
 // A flat strip [0, 3] x [0, 1]: the left unit square is two large triangles, the right part
