@@ -2,6 +2,8 @@
 // points, TBB for the parallel queries.
 #include "vertexflow/distance.h"
 
+#include "numerics/vertex_ordering.h"
+
 #include <CGAL/AABB_traits.h>
 #include <CGAL/AABB_tree.h>
 #include <CGAL/Simple_cartesian.h>
@@ -168,17 +170,6 @@ Eigen::Vector3d barycentric(const Eigen::Vector3d& q, const Eigen::Vector3d& a, 
   return db <= dc ? Eigen::Vector3d(0, 1, 0) : Eigen::Vector3d(0, 0, 1);
 }
 
-// Spreads the low 21 bits of x to every third bit (a Morton code's one axis).
-std::uint64_t spread_bits(std::uint64_t x) {
-  x &= 0x1fffff;
-  x = (x | x << 32) & 0x1f00000000ffffULL;
-  x = (x | x << 16) & 0x1f0000ff0000ffULL;
-  x = (x | x << 8) & 0x100f00f00f00f00fULL;
-  x = (x | x << 4) & 0x10c30c30c30c30c3ULL;
-  x = (x | x << 2) & 0x1249249249249249ULL;
-  return x;
-}
-
 // Sorts the rows [first, first + count) of P along a Morton curve in P's bounding box (ties by
 // row, so the order is fixed). For a thinned subset of vertices or midpoints: in index order
 // consecutive points are far apart, so each query's first guess (the previous answer's
@@ -196,7 +187,7 @@ void sort_along_morton_curve(Vertices& P, std::int64_t first, std::int64_t count
   for (std::int64_t i = 0; i < count; ++i) {
     const Eigen::RowVector3d t = (rows.row(i) - low).cwiseProduct(scale);
     key[static_cast<std::size_t>(i)] = {
-        spread_bits(cell(t.x())) | spread_bits(cell(t.y())) << 1 | spread_bits(cell(t.z())) << 2, i};
+        morton_spread_21(cell(t.x())) | morton_spread_21(cell(t.y())) << 1 | morton_spread_21(cell(t.z())) << 2, i};
   }
   std::sort(key.begin(), key.end());
   const Vertices copy = rows;

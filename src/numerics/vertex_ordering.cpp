@@ -16,20 +16,11 @@ std::vector<Index> space_filling_order(const Vertices& P) {
   if (n == 0) return {};
   const Eigen::RowVector3d low = P.colwise().minCoeff(), high = P.colwise().maxCoeff();
   const double extent = std::max((high - low).maxCoeff(), 1e-300);
-  auto spread = [](std::uint64_t v) {  // 21 bits -> every third bit of 63
-    v &= 0x1fffffULL;
-    v = (v | v << 32) & 0x1f00000000ffffULL;
-    v = (v | v << 16) & 0x1f0000ff0000ffULL;
-    v = (v | v << 8) & 0x100f00f00f00f00fULL;
-    v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
-    v = (v | v << 2) & 0x1249249249249249ULL;
-    return v;
-  };
   parallel_for_index(n, [&](Index i) {
     std::uint64_t code = 0;
     for (int c = 0; c < 3; ++c) {
       const double unit = (P(i, c) - low[c]) / extent;
-      code |= spread(static_cast<std::uint64_t>(std::clamp(unit, 0.0, 1.0) * 2097151.0)) << c;
+      code |= morton_spread_21(static_cast<std::uint64_t>(std::clamp(unit, 0.0, 1.0) * 2097151.0)) << c;
     }
     keys[static_cast<std::size_t>(i)] = {code, i};
   });

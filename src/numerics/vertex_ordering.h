@@ -8,9 +8,21 @@
 #include "vertexflow/mesh.h"
 #include "vertexflow/topology.h"
 
+#include <cstdint>
 #include <vector>
 
 namespace vertexflow {
+
+/// The low 21 bits of v spread to every third bit of 63: one axis of a Morton code.
+inline std::uint64_t morton_spread_21(std::uint64_t v) {
+  v &= 0x1fffffULL;
+  v = (v | v << 32) & 0x1f00000000ffffULL;
+  v = (v | v << 16) & 0x1f0000ff0000ffULL;
+  v = (v | v << 8) & 0x100f00f00f00f00fULL;
+  v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
+  v = (v | v << 2) & 0x1249249249249249ULL;
+  return v;
+}
 
 /// Vertices sorted by the Morton code of their position (21 bits per axis), ties by index.
 std::vector<Index> space_filling_order(const Vertices& P);
