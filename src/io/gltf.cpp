@@ -6,6 +6,7 @@
 #include "gltf.h"
 
 #include "io_internal.h"
+#include "mesh/position_key.h"
 
 #include <fmt/format.h>
 
@@ -421,14 +422,6 @@ struct PendingChannel {
   std::vector<int> part_width;
 };
 
-struct BitwiseHash {
-  std::size_t operator()(const std::array<std::uint64_t, 3>& p) const {
-    std::uint64_t h = 0x9e3779b97f4a7c15ull;
-    for (const auto x : p) h = (h ^ x) * 0xff51afd7ed558ccdull ^ (h >> 29);
-    return static_cast<std::size_t>(h);
-  }
-};
-
 Mesh build_mesh(std::shared_ptr<GltfDocument> document, const std::string& name, ReadReport& report,
                 const ReadOptions& options) {
   GltfDocument& doc = *document;
@@ -438,7 +431,7 @@ Mesh build_mesh(std::shared_ptr<GltfDocument> document, const std::string& name,
   std::vector<PendingChannel> channels;
   std::vector<std::int32_t> face_rows;  // 3 per face
   std::vector<double> primitive_label, material_label;
-  std::unordered_map<std::array<std::uint64_t, 3>, Index, BitwiseHash> welded;
+  std::unordered_map<PositionKey, Index, PositionKeyHash> welded;
   std::int64_t rows = 0;
   for (std::size_t m = 0; m < model.meshes.size(); ++m) {
     welded.clear();  // vertices weld within one glTF mesh only
@@ -486,14 +479,10 @@ Mesh build_mesh(std::shared_ptr<GltfDocument> document, const std::string& name,
 
       std::vector<double> xyz = read_values(positions, name);
       for (std::size_t i = 0; i < positions.count; ++i) {
-        std::array<std::uint64_t, 3> key{};
-        for (std::size_t c = 0; c < 3; ++c) {
-          double& x = xyz[3 * i + c];
-          if (dequantized("POSITION", positions)) x = dequantize(x, positions.type);
-          const double bits = x + 0.0;  // -0 welds with +0
-          std::memcpy(&key[c], &bits, sizeof(double));
-        }
-        const auto [it, inserted] = welded.try_emplace(key, static_cast<Index>(soup.num_vertices()));
+        if (dequantized("POSITION", positions))
+          for (std::size_t c = 0; c < 3; ++c) xyz[3 * i + c] = dequantize(xyz[3 * i + c], positions.type);
+        const auto [it, inserted] =
+            welded.try_emplace(position_key(xyz.data() + 3 * i), static_cast<Index>(soup.num_vertices()));
         if (inserted) soup.add_vertex(xyz[3 * i], xyz[3 * i + 1], xyz[3 * i + 2]);
         doc.vertex_of_row.push_back(it->second);
       }

@@ -3,6 +3,7 @@
 #include "gltf.h"
 #include "io_internal.h"
 #include "mesh/duplicate_faces.h"
+#include "mesh/position_key.h"
 
 #include <zlib.h>
 
@@ -113,29 +114,17 @@ FileBytes read_file_bytes(const std::filesystem::path& path) {
   return bytes;
 }
 
-struct BitwisePositionHash {
-  std::size_t operator()(const std::array<std::uint64_t, 3>& p) const {
-    std::uint64_t h = 0x9e3779b97f4a7c15ull;
-    for (const auto x : p) h = (h ^ x) * 0xff51afd7ed558ccdull ^ (h >> 29);
-    return static_cast<std::size_t>(h);
-  }
-};
-
 // Merges vertices with identical coordinates (STL facets). Keeps first-occurrence order.
 void weld_identical_vertices(PolygonSoup& soup, ReadReport& report) {
   const std::size_t nv = static_cast<std::size_t>(soup.num_vertices());
-  std::unordered_map<std::array<std::uint64_t, 3>, Index, BitwisePositionHash> index_of;
+  std::unordered_map<PositionKey, Index, PositionKeyHash> index_of;
   index_of.reserve(nv / 4 + 16);
   std::vector<Index> remap(nv);
   std::vector<double> welded;
   welded.reserve(soup.xyz.size() / 4 + 16);
   for (std::size_t v = 0; v < nv; ++v) {
-    std::array<std::uint64_t, 3> key{};
-    for (int c = 0; c < 3; ++c) {
-      const double x = soup.xyz[3 * v + static_cast<std::size_t>(c)] + 0.0;  // -0 becomes +0
-      std::memcpy(&key[static_cast<std::size_t>(c)], &x, sizeof(double));
-    }
-    const auto [it, inserted] = index_of.try_emplace(key, static_cast<Index>(welded.size() / 3));
+    const auto [it, inserted] =
+        index_of.try_emplace(position_key(soup.xyz.data() + 3 * v), static_cast<Index>(welded.size() / 3));
     if (inserted)
       welded.insert(welded.end(), soup.xyz.begin() + 3 * static_cast<std::ptrdiff_t>(v),
                     soup.xyz.begin() + 3 * static_cast<std::ptrdiff_t>(v) + 3);

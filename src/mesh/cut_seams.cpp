@@ -1,35 +1,14 @@
 // Seams stored cut open (mesh/cut_seams.h).
 #include "mesh/cut_seams.h"
 
+#include "mesh/fan_walk.h"
+#include "mesh/position_key.h"
+
 #include <cstdint>
-#include <cstring>
 #include <unordered_map>
 
 namespace vertexflow {
 namespace {
-
-using PositionKey = std::array<std::uint64_t, 3>;
-
-PositionKey position_key(const Vertices& V, Index v) {
-  PositionKey key;
-  for (int c = 0; c < 3; ++c) {
-    const double x = V(v, c) + 0.0;  // -0 keys as +0
-    std::memcpy(&key[static_cast<std::size_t>(c)], &x, sizeof x);
-  }
-  return key;
-}
-
-struct PositionHash {
-  std::size_t operator()(const PositionKey& k) const {
-    std::uint64_t h = 0x9e3779b97f4a7c15ull;
-    for (const std::uint64_t x : k) h = (h ^ x) * 0x100000001b3ull;
-    return static_cast<std::size_t>(h ^ (h >> 29));
-  }
-};
-
-std::uint64_t pair_key(Index a, Index b) {
-  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(a)) << 32) | static_cast<std::uint32_t>(b);
-}
 
 // Union-find whose root is the lowest index of its set.
 Index root_of(std::vector<Index>& parent, Index v) {
@@ -65,11 +44,10 @@ CutSeams find_cut_seams(const Vertices& V, const Faces& F, const Topology& topol
   // check after welding judges the welded vertex.)
   std::vector<Index> position_of(n, -1);  // the lowest boundary vertex at the same position
   {
-    std::unordered_map<PositionKey, Index, PositionHash> first_at;
+    std::unordered_map<PositionKey, Index, PositionKeyHash> first_at;
     for (std::size_t v = 0; v < n; ++v)
       if (topology.is_boundary_vertex[v])
-        position_of[v] =
-            first_at.try_emplace(position_key(V, static_cast<Index>(v)), static_cast<Index>(v)).first->second;
+        position_of[v] = first_at.try_emplace(position_key(V.data() + 3 * v), static_cast<Index>(v)).first->second;
   }
 
   // Boundary half-edges by the positions they join: a seam side is the only one from its start
@@ -86,7 +64,7 @@ CutSeams find_cut_seams(const Vertices& V, const Faces& F, const Topology& topol
            position_of[static_cast<std::size_t>(F(f, (k + 1) % 3))] >= 0;
   };
   auto key_of = [&](Index from, Index to) {
-    return pair_key(position_of[static_cast<std::size_t>(from)], position_of[static_cast<std::size_t>(to)]);
+    return half_edge_key(position_of[static_cast<std::size_t>(from)], position_of[static_cast<std::size_t>(to)]);
   };
   for (Index f = 0; f < topology.num_faces; ++f)
     for (int k = 0; k < 3; ++k)
