@@ -133,12 +133,15 @@ BlockSparseMatrix galerkin_upper(const FlowTerms& t, const AggregationCoarseSpac
   // ranges.
   constexpr std::size_t kRanges = 32, kMinRange = 4096;
   const std::size_t range = std::max(kMinRange, (na + kRanges - 1) / kRanges);
-  std::vector<BlockSparseMatrix> parts;
   std::vector<Index> vertices;
   std::vector<std::size_t> local_start;
   std::vector<Local> locals;
-  for (std::size_t a0 = 0; a0 < na; a0 += range) {
-    const std::size_t a1 = std::min(na, a0 + range);
+  std::size_t first = 0;                                         // the range's first aggregate
+  std::vector<std::size_t> touch_start;                          // per aggregate of the range
+  std::vector<std::pair<std::uint32_t, std::uint32_t>> touches;  // (vertex in range, k)
+  auto prepare = [&](int range_first, int range_last) {
+    const auto a0 = static_cast<std::size_t>(range_first), a1 = static_cast<std::size_t>(range_last);
+    first = a0;
     vertices.clear();
     for (std::size_t i = 0; i < n; ++i)
       if (local_size[i] > 0 && static_cast<std::size_t>(lowest[i]) < a1 && static_cast<std::size_t>(highest[i]) >= a0)
@@ -178,44 +181,42 @@ BlockSparseMatrix galerkin_upper(const FlowTerms& t, const AggregationCoarseSpac
       std::sort(out, out + size, [](const Local& x, const Local& y) { return x.aggregate < y.aggregate; });
     });
     // The locals of each aggregate of the range, by vertex (counting sort, so in vertex order).
-    std::vector<std::size_t> touch_start(a1 - a0 + 1, 0);
+    touch_start.assign(a1 - a0 + 1, 0);
     for (const Local& x : locals)
       if (static_cast<std::size_t>(x.aggregate) >= a0 && static_cast<std::size_t>(x.aggregate) < a1)
         ++touch_start[static_cast<std::size_t>(x.aggregate) - a0 + 1];
     for (std::size_t a = a0; a < a1; ++a) touch_start[a - a0 + 1] += touch_start[a - a0];
-    std::vector<std::pair<std::uint32_t, std::uint32_t>> touches(touch_start.back());  // (vertex in range, k)
-    {
-      std::vector<std::size_t> fill(touch_start.begin(), touch_start.end() - 1);
-      for (std::size_t c = 0; c < m; ++c)
-        for (std::size_t k = local_start[c]; k < local_start[c + 1]; ++k) {
-          const auto a = static_cast<std::size_t>(locals[k].aggregate);
-          if (a >= a0 && a < a1)
-            touches[fill[a - a0]++] = {static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(k - local_start[c])};
-        }
-    }
-    // Row a of the upper half of H_c: blocks (a, b), b >= a, summed over the vertices in order.
-    parts.push_back(
-        build_block_rows(static_cast<int>(a1 - a0), static_cast<int>(na), [&](int r, BlockRowAccumulator& row) {
-          for (std::size_t e = touch_start[static_cast<std::size_t>(r)];
-               e < touch_start[static_cast<std::size_t>(r) + 1]; ++e) {
-            const auto [c, k] = touches[e];
-            const auto v = static_cast<std::size_t>(vertices[c]);
-            const Local* local = locals.data() + local_start[c];
-            const Local& x = local[k];
-            const Eigen::Matrix3d left = x.g * t.P[v].full();
-            const Eigen::Matrix3d D = t.D[v].full();             // phi is 0 at fixed vertices, so their D drops out
-            for (std::uint32_t q = k; q < local_size[v]; ++q) {  // sorted, so local[q].aggregate >= a
-              const Local& y = local[q];
-              Eigen::Matrix3d& block = row[y.aggregate];
-              block.noalias() += left * y.g;
-              block.diagonal().array() += t.smooth[v] * x.l * y.l;
-              block.noalias() += (x.phi * y.phi) * D;
-            }
+    touches.resize(touch_start.back());
+    std::vector<std::size_t> fill(touch_start.begin(), touch_start.end() - 1);
+    for (std::size_t c = 0; c < m; ++c)
+      for (std::size_t k = local_start[c]; k < local_start[c + 1]; ++k) {
+        const auto a = static_cast<std::size_t>(locals[k].aggregate);
+        if (a >= a0 && a < a1)
+          touches[fill[a - a0]++] = {static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(k - local_start[c])};
+      }
+  };
+  // Row a of the upper half of H_c: blocks (a, b), b >= a, summed over the vertices in order.
+  return build_block_rows(
+      static_cast<int>(na), static_cast<int>(na),
+      [&](int a, BlockRowAccumulator& row) {
+        const std::size_t r = static_cast<std::size_t>(a) - first;
+        for (std::size_t e = touch_start[r]; e < touch_start[r + 1]; ++e) {
+          const auto [c, k] = touches[e];
+          const auto v = static_cast<std::size_t>(vertices[c]);
+          const Local* local = locals.data() + local_start[c];
+          const Local& x = local[k];
+          const Eigen::Matrix3d left = x.g * t.P[v].full();
+          const Eigen::Matrix3d D = t.D[v].full();             // phi is 0 at fixed vertices, so their D drops out
+          for (std::uint32_t q = k; q < local_size[v]; ++q) {  // sorted, so local[q].aggregate >= a
+            const Local& y = local[q];
+            Eigen::Matrix3d& block = row[y.aggregate];
+            block.noalias() += left * y.g;
+            block.diagonal().array() += t.smooth[v] * x.l * y.l;
+            block.noalias() += (x.phi * y.phi) * D;
           }
-        }));
-  }
-  std::vector<Local>().swap(locals);
-  return stack_block_rows(std::move(parts), static_cast<int>(na));
+        }
+      },
+      static_cast<int>(range), prepare);
 }
 
 }  // namespace vertexflow

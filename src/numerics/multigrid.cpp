@@ -119,20 +119,21 @@ std::vector<std::pair<int, Matrix3>> BlockRowAccumulator::take() {
   return std::exchange(entries_, {});
 }
 
-BlockSparseMatrix build_block_rows(int rows, int cols, const std::function<void(int, BlockRowAccumulator&)>& body) {
+BlockSparseMatrix build_block_rows(int rows, int cols, const std::function<void(int, BlockRowAccumulator&)>& body,
+                                   int range_rows, const std::function<void(int, int)>& prepare) {
   // Rows are built a range at a time and appended, so that rows under construction exist for
   // one range only: all of them beside the finished matrix were twice its size, the peak of the
   // multilevel set-up on large meshes (docs/benchmarks.md). The first range's density sizes the
   // arrays (with a margin), so that they rarely grow, and never by copying most of the matrix.
-  constexpr int kRangeRows = 8192;
   BlockSparseMatrix A;
   A.rows = rows;
   A.cols = cols;
   A.start.assign(static_cast<std::size_t>(rows) + 1, 0);
   tbb::enumerable_thread_specific<BlockRowAccumulator> accumulators([cols] { return BlockRowAccumulator(cols); });
   std::vector<std::vector<std::pair<int, Matrix3>>> built;
-  for (int r0 = 0; r0 < rows; r0 += kRangeRows) {
-    const int r1 = std::min(rows, r0 + kRangeRows);
+  for (int r0 = 0; r0 < rows; r0 += range_rows) {
+    const int r1 = std::min(rows, r0 + range_rows);
+    if (prepare) prepare(r0, r1);
     built.assign(static_cast<std::size_t>(r1 - r0), {});
     // Always in parallel: unlike the per-iteration products, a set-up row costs many blocks.
     tbb::parallel_for(tbb::blocked_range<int>(r0, r1, 16), [&](const tbb::blocked_range<int>& range) {
@@ -159,27 +160,6 @@ BlockSparseMatrix build_block_rows(int rows, int cols, const std::function<void(
       }
       std::vector<std::pair<int, Matrix3>>().swap(row);
     }
-  }
-  return A;
-}
-
-BlockSparseMatrix stack_block_rows(std::vector<BlockSparseMatrix>&& parts, int cols) {
-  BlockSparseMatrix A;
-  A.cols = cols;
-  std::size_t blocks = 0;
-  for (const BlockSparseMatrix& part : parts) {
-    A.rows += part.rows;
-    blocks += part.column.size();
-  }
-  A.start.reserve(static_cast<std::size_t>(A.rows) + 1);
-  A.column.reserve(blocks);
-  A.block.reserve(blocks);
-  for (BlockSparseMatrix& part : parts) {
-    const int offset = A.start.back();
-    for (int k = 0; k < part.rows; ++k) A.start.push_back(offset + part.start[static_cast<std::size_t>(k) + 1]);
-    A.column.insert(A.column.end(), part.column.begin(), part.column.end());
-    A.block.insert(A.block.end(), part.block.begin(), part.block.end());
-    part = BlockSparseMatrix();
   }
   return A;
 }
@@ -291,15 +271,13 @@ namespace {
 // set-up. Each row of A P and each block of the product is summed in the order of the whole
 // product, so the result is the same.
 BlockSparseMatrix galerkin_product(const BlockSparseMatrix& A, const BlockSparseMatrix& P, const BlockSparseMatrix& R) {
-  constexpr int kRangeRows = 8192;
-  const int count = R.rows;
   std::vector<int> slot(static_cast<std::size_t>(A.rows), -1);  // row of A P -> its place in `ap`
   std::vector<int> needed;
   std::vector<std::vector<std::pair<int, Matrix3>>> ap;
   tbb::enumerable_thread_specific<BlockRowAccumulator> accumulators([&] { return BlockRowAccumulator(P.cols); });
-  std::vector<BlockSparseMatrix> parts;
-  for (int i0 = 0; i0 < count; i0 += kRangeRows) {
-    const int i1 = std::min(count, i0 + kRangeRows);
+  // Before each range of coarse rows: the rows of A P it reads, in place of the last range's.
+  auto prepare = [&](int i0, int i1) {
+    for (const int k : needed) slot[static_cast<std::size_t>(k)] = -1;
     needed.clear();
     for (int m = R.start[static_cast<std::size_t>(i0)]; m < R.start[static_cast<std::size_t>(i1)]; ++m) {
       const int k = R.column[static_cast<std::size_t>(m)];
@@ -323,18 +301,18 @@ BlockSparseMatrix galerkin_product(const BlockSparseMatrix& A, const BlockSparse
             ap[t] = row.take();
           }
         });
-    parts.push_back(build_block_rows(i1 - i0, P.cols, [&](int r, BlockRowAccumulator& row) {
-      const auto i = static_cast<std::size_t>(i0 + r);
-      for (int m = R.start[i]; m < R.start[i + 1]; ++m) {
-        const Matrix3& left = R.block[static_cast<std::size_t>(m)];
-        for (const auto& [column, block] :
-             ap[static_cast<std::size_t>(slot[static_cast<std::size_t>(R.column[static_cast<std::size_t>(m)])])])
-          row[column].noalias() += left * block;
-      }
-    }));
-    for (const int k : needed) slot[static_cast<std::size_t>(k)] = -1;
-  }
-  return stack_block_rows(std::move(parts), P.cols);
+  };
+  return build_block_rows(
+      R.rows, P.cols,
+      [&](int i, BlockRowAccumulator& row) {
+        for (int m = R.start[static_cast<std::size_t>(i)]; m < R.start[static_cast<std::size_t>(i) + 1]; ++m) {
+          const Matrix3& left = R.block[static_cast<std::size_t>(m)];
+          for (const auto& [column, block] :
+               ap[static_cast<std::size_t>(slot[static_cast<std::size_t>(R.column[static_cast<std::size_t>(m)])])])
+            row[column].noalias() += left * block;
+        }
+      },
+      8192, prepare);
 }
 
 }  // namespace

@@ -50,12 +50,10 @@ class BlockRowAccumulator {
 
 /// A rows x cols block matrix whose row k is what body(k, row) adds to `row`. Rows are built
 /// in parallel, each row's blocks summed in the order body adds them, so the result does not
-/// depend on the threads.
-BlockSparseMatrix build_block_rows(int rows, int cols, const std::function<void(int, BlockRowAccumulator&)>& body);
-
-/// The rows of `parts` one after the other, as one matrix of `cols` block columns; each part is
-/// freed once copied.
-BlockSparseMatrix stack_block_rows(std::vector<BlockSparseMatrix>&& parts, int cols);
+/// depend on the threads. They are built `range_rows` at a time, and `prepare(first, last)`, when
+/// given, runs before the rows [first, last) are: what body reads for those rows only.
+BlockSparseMatrix build_block_rows(int rows, int cols, const std::function<void(int, BlockRowAccumulator&)>& body,
+                                   int range_rows = 8192, const std::function<void(int, int)>& prepare = {});
 
 /// The symmetric matrix whose upper half (diagonal included) is `upper`'s; `upper` must hold
 /// no block below the diagonal.
