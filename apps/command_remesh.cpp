@@ -7,7 +7,8 @@
 
 #include <fmt/format.h>
 
-#include <chrono>
+#include <map>
+#include <string>
 
 namespace vertexflow::cli {
 namespace {
@@ -47,6 +48,25 @@ void register_remesh_command(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str();
   command->add_flag("--protect-boundary", o->remesh.isotropic.protect_boundary,
                     "Keep boundary edges exactly as in the input (default: resample them along the boundary)");
+  command
+      ->add_option("--small-pieces", o->remesh.isotropic.small_pieces,
+                   "Pieces too small to remesh (see --small-piece-edges): remove them, or keep them unchanged")
+      ->transform(CLI::CheckedTransformer(
+          std::map<std::string, SmallPieces>{{"remove", SmallPieces::remove}, {"keep", SmallPieces::keep}},
+          CLI::ignore_case))
+      ->default_str("remove");
+  command
+      ->add_option("--small-piece-edges", o->remesh.isotropic.small_piece_edges,
+                   "A connected piece whose bounding-box diagonal is below this many target edges is too small to "
+                   "remesh (0: remesh every piece)")
+      ->check(CLI::Range(0.0, 1000.0))
+      ->capture_default_str();
+  command
+      ->add_option("--short-loop-edges", o->remesh.isotropic.short_loop_edges,
+                   "A boundary loop shorter than this many target edges is kept, not collapsed (0: resample every "
+                   "loop)")
+      ->check(CLI::Range(0.0, 1000.0))
+      ->capture_default_str();
   command->add_flag("--json", o->json, "Print a summary as JSON on stdout");
   command->add_flag("--force", o->force, "Allow OUT to be the input file");
   command->callback([o, &global] {
@@ -56,12 +76,7 @@ void register_remesh_command(CLI::App& app, const GlobalOptions& global) {
     RemeshResult result;
     try {
       if (o->edge_length > 0) {
-        const auto start = std::chrono::steady_clock::now();
-        result.mesh = remesh_isotropic(mesh.V, mesh.F, o->edge_length, o->remesh.isotropic, &result.report.repairs);
-        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-        result.report.attempts.push_back({o->edge_length, result.mesh.num_vertices(), seconds});
-        result.report.edge_length = o->edge_length;
-        result.report.seconds = seconds;
+        result = remesh_to_edge_length(mesh.V, mesh.F, o->edge_length, o->remesh.isotropic);
       } else {
         result = remesh_to_vertex_count(mesh.V, mesh.F, o->remesh);
       }
@@ -70,7 +85,8 @@ void register_remesh_command(CLI::App& app, const GlobalOptions& global) {
     }
     const RemeshReport& r = result.report;
     const bool searched = o->edge_length == 0;
-    const QualityStats quality = summarize_quality(triangle_quality(result.mesh.V, result.mesh.F));
+    const QualityStats& quality = r.quality.all;
+    const RemeshCleanup& cleanup = r.cleanup;
     if (!global.quiet) {
       for (std::size_t i = 0; i < r.attempts.size(); ++i)
         fmt::print(stderr, "vertexflow: run {}: edge length {:.6g} -> {} vertices ({:.2f} s)\n", i + 1,
@@ -80,11 +96,32 @@ void register_remesh_command(CLI::App& app, const GlobalOptions& global) {
                  searched ? fmt::format(" (target {})", o->remesh.target_vertices) : "", r.edge_length, r.seconds);
       fmt::print(stderr, "vertexflow: quality 2r/R: min {:.3f}, p5 {:.3f}, mean {:.3f}, {:.2f}% below 0.3\n",
                  quality.min, quality.p5, quality.mean, 100 * quality.fraction_below_0_3);
+      if (r.quality.rim_faces > 0)
+        fmt::print(stderr,
+                   "vertexflow: below 0.3: {:.2f}% of {} interior faces, {:.2f}% of {} rim faces (a corner on one of "
+                   "{} boundary loops)\n",
+                   100 * r.quality.interior.fraction_below_0_3, r.quality.interior_faces,
+                   100 * r.quality.rim.fraction_below_0_3, r.quality.rim_faces, r.quality.boundary_loops);
       if (searched && !r.within_tolerance)
         fmt::print(stderr, "vertexflow: warning: {}: {} vertices is outside the {}% tolerance after {} runs\n",
                    o->input, result.mesh.num_vertices(), 100 * o->remesh.tolerance, r.attempts.size());
     }
     warn_about_repairs(o->input, r.repairs, global);
+    if (!global.quiet && cleanup.small_pieces > 0)
+      fmt::print(stderr,
+                 "vertexflow: warning: {}: {} pieces ({} faces) smaller than {:g} target edges across, too small to "
+                 "remesh: {}\n",
+                 o->input, cleanup.small_pieces, cleanup.small_piece_faces, o->remesh.isotropic.small_piece_edges,
+                 cleanup.small_pieces_kept ? "kept unchanged" : "removed (--small-pieces keep keeps them)");
+    if (!global.quiet && cleanup.short_loops > 0)
+      fmt::print(stderr,
+                 "vertexflow: {}: {} boundary loops shorter than {:g} target edges kept ({} of their vertices held)\n",
+                 o->input, cleanup.short_loops, o->remesh.isotropic.short_loop_edges, cleanup.held_loop_vertices);
+    if (!global.quiet && cleanup.collapsed_short_edges + cleanup.flipped_cap_edges + cleanup.removed_cap_faces > 0)
+      fmt::print(stderr,
+                 "vertexflow: warning: {}: the result had {} edges shorter than 1e-4 target edges (collapsed) and "
+                 "zero-area faces ({} flipped, {} removed at the boundary)\n",
+                 o->input, cleanup.collapsed_short_edges, cleanup.flipped_cap_edges, cleanup.removed_cap_faces);
     write_mesh(o->output, result.mesh);
     if (o->json) {
       nlohmann::json out;
@@ -106,6 +143,25 @@ void register_remesh_command(CLI::App& app, const GlobalOptions& global) {
       out["protect_boundary"] = o->remesh.isotropic.protect_boundary;
       out["seconds"] = r.seconds;
       out["quality"] = nlohmann::json(quality);
+      out["quality_interior"] = nlohmann::json(r.quality.interior);
+      out["quality_rim"] = nlohmann::json(r.quality.rim);
+      out["interior_faces"] = r.quality.interior_faces;
+      out["rim_faces"] = r.quality.rim_faces;
+      out["components"] = r.quality.components;
+      out["boundary_loops"] = r.quality.boundary_loops;
+      out["non_manifold_vertices"] = r.quality.non_manifold_vertices;
+      out["zero_area_faces"] = r.quality.zero_area_faces;
+      out["min_edge_length"] = r.quality.min_edge_length;
+      out["small_piece_edges"] = o->remesh.isotropic.small_piece_edges;
+      out["short_loop_edges"] = o->remesh.isotropic.short_loop_edges;
+      out["cleanup"] = {{"small_pieces", cleanup.small_pieces},
+                        {"small_piece_faces", cleanup.small_piece_faces},
+                        {"small_pieces_kept", cleanup.small_pieces_kept},
+                        {"short_loops_kept", cleanup.short_loops},
+                        {"held_loop_vertices", cleanup.held_loop_vertices},
+                        {"collapsed_short_edges", cleanup.collapsed_short_edges},
+                        {"flipped_cap_edges", cleanup.flipped_cap_edges},
+                        {"removed_cap_faces", cleanup.removed_cap_faces}};
       out["repairs"] = to_json(r.repairs);
       fmt::print("{}\n", out.dump(2));
     }

@@ -20,17 +20,30 @@
 // - Input: any triangle mesh. One that is not manifold or not consistently oriented is remeshed
 //   through its manifold split (manifold_split.h): non-manifold vertices duplicated,
 //   non-manifold edges cut into boundaries, faces oriented per component.
-// - Output: manifold and consistently oriented, without zero-area faces; what it took is in
-//   SurfaceRepairs (on inputs with many holes CGAL's collapses can pinch a vertex between two
+// - Output: manifold and consistently oriented, without zero-area faces and without edges
+//   shorter than 1e-4 of the target length; what it took is in SurfaceRepairs and
+//   RemeshCleanup (on inputs with many holes CGAL's collapses can pinch a vertex between two
 //   loops or leave a zero-area face).
+// - Raw scans (issue 31; docs/remesh.md): connected pieces too small to remesh (bounding box
+//   diagonal below small_piece_edges target edges) are removed, or with
+//   SmallPieces::keep copied to the output as they are; boundary loops shorter than
+//   short_loop_edges target edges are kept: never collapsed, some of their vertices held at
+//   their input positions. Neither changes a mesh without such pieces or loops.
 #pragma once
 
 #include "vertexflow/manifold_split.h"
 #include "vertexflow/mesh.h"
+#include "vertexflow/quality.h"
 
 #include <vector>
 
 namespace vertexflow {
+
+/// What happens to connected pieces of the input too small to remesh.
+enum class SmallPieces {
+  remove,  ///< left out of the output
+  keep,    ///< copied to the output unchanged (their faces are not remeshed)
+};
 
 /// One CGAL isotropic_remeshing run.
 struct IsotropicRemeshOptions {
@@ -40,7 +53,49 @@ struct IsotropicRemeshOptions {
   int relaxation_steps = 1;
   /// Keep boundary edges exactly as in the input instead of resampling them.
   bool protect_boundary = false;
+  /// A connected piece whose bounding-box diagonal is below this many target edge lengths is
+  /// too small to remesh (>= 0; 0 remeshes every piece). CGAL turns such a piece into one or a
+  /// few faces of any shape (docs/remesh.md).
+  double small_piece_edges = 2.0;
+  SmallPieces small_pieces = SmallPieces::remove;
+  /// A boundary loop shorter than this many target edge lengths is kept (>= 0; 0 resamples
+  /// every loop): instead of collapsing it to a triangle of short edges, about one vertex per
+  /// half target edge (at least 3) stays at its input position.
+  double short_loop_edges = 3.0;
 };
+
+/// What remeshing a raw scan took beyond CGAL's run (all 0 on a clean input).
+struct RemeshCleanup {
+  Index small_pieces = 0;           ///< input pieces too small to remesh
+  Index small_piece_faces = 0;      ///< their input faces
+  bool small_pieces_kept = false;   ///< copied unchanged (SmallPieces::keep) rather than removed
+  Index short_loops = 0;            ///< input boundary loops shorter than short_loop_edges, kept
+  Index held_loop_vertices = 0;     ///< their vertices held at input positions
+  Index collapsed_short_edges = 0;  ///< result edges below 1e-4 target lengths, collapsed
+  Index flipped_cap_edges = 0;      ///< longest edges of zero-area faces, flipped
+  Index removed_cap_faces = 0;      ///< zero-area faces on the boundary, removed
+  [[nodiscard]] bool any() const {
+    return small_pieces + short_loops + collapsed_short_edges + flipped_cap_edges + removed_cap_faces > 0;
+  }
+};
+
+/// Quality of a remesh, over all its faces and apart for the faces at the boundary (rim faces:
+/// a corner on a boundary loop) and the others (interior faces). Boundary vertices stay on
+/// the input's rims, so rim faces can be poor where rims are short or close together.
+struct RemeshQuality {
+  QualityStats all, interior, rim;
+  Index interior_faces = 0;
+  Index rim_faces = 0;
+  Index components = 0;
+  Index boundary_loops = 0;
+  Index non_manifold_vertices = 0;
+  Index zero_area_faces = 0;  ///< degenerate_faces (mesh.h): 0 for every remesh
+  double min_edge_length = 0;
+};
+
+/// The quality of (V, F) as RemeshQuality describes it. Throws std::invalid_argument for an
+/// index out of range.
+RemeshQuality remesh_quality(const Vertices& V, const Faces& F);
 
 /// Remeshes (V, F) with target edge length `edge_length` (> 0, input units): CGAL splits edges
 /// longer than 4/3 of it and collapses those shorter than 4/5 of it. `repairs` (if given)
@@ -79,6 +134,8 @@ struct RemeshReport {
   bool within_tolerance = false;
   double seconds = 0;      ///< all attempts
   SurfaceRepairs repairs;  ///< of the returned result
+  RemeshCleanup cleanup;   ///< of the returned result
+  RemeshQuality quality;   ///< of the returned result
 };
 
 struct RemeshResult {
@@ -98,5 +155,10 @@ struct RemeshResult {
 /// RemeshReport::within_tolerance says so. Throws std::invalid_argument like
 /// remesh_isotropic, or for options out of range.
 RemeshResult remesh_to_vertex_count(const Vertices& V, const Faces& F, const RemeshOptions& options = {});
+
+/// remesh_isotropic with the whole report: one attempt, the cleanup and the quality. Throws
+/// like remesh_isotropic.
+RemeshResult remesh_to_edge_length(const Vertices& V, const Faces& F, double edge_length,
+                                   const IsotropicRemeshOptions& options = {});
 
 }  // namespace vertexflow

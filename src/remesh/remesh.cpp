@@ -4,17 +4,21 @@
 
 #include "surface_mesh_conversion.h"
 #include "vertexflow/timing.h"
+#include "vertexflow/topology.h"
 
 #include <CGAL/Polygon_mesh_processing/remesh.h>
+#include <CGAL/boost/graph/Euler_operations.h>
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 namespace vertexflow {
 namespace {
@@ -22,18 +26,247 @@ namespace {
 namespace PMP = CGAL::Polygon_mesh_processing;
 using remesh_detail::SurfaceMesh;
 
+using VertexIndex = SurfaceMesh::Vertex_index;
+using FaceIndex = SurfaceMesh::Face_index;
+using HalfedgeIndex = SurfaceMesh::Halfedge_index;
+using EdgeIndex = SurfaceMesh::Edge_index;
+
 void check_options(const IsotropicRemeshOptions& options) {
   if (options.iterations < 1) throw std::invalid_argument("remesh: iterations must be at least 1");
   if (options.relaxation_steps < 0) throw std::invalid_argument("remesh: relaxation steps must not be negative");
+  if (!(options.small_piece_edges >= 0) || !std::isfinite(options.small_piece_edges))
+    throw std::invalid_argument("remesh: small_piece_edges must be a finite number >= 0");
+  if (!(options.short_loop_edges >= 0) || !std::isfinite(options.short_loop_edges))
+    throw std::invalid_argument("remesh: short_loop_edges must be a finite number >= 0");
+}
+
+// Edges shorter than this many target lengths are collapsed after CGAL's run (issue 31: a raw
+// scan's remesh had edges of 1e-8). Clean remeshes have none below about 0.3.
+constexpr double kMinEdgeFraction = 1e-4;
+// Faces below this many times degenerate_faces' area bound (mesh.h) are repaired after the run,
+// with a margin so that a result written as text and read back keeps none.
+constexpr double kCapAreaMargin = 10.0;
+
+double length(const SurfaceMesh& mesh, HalfedgeIndex h) {
+  return std::sqrt(CGAL::squared_distance(mesh.point(mesh.source(h)), mesh.point(mesh.target(h))));
+}
+
+double area(const SurfaceMesh& mesh, FaceIndex f) {
+  const HalfedgeIndex h = mesh.halfedge(f);
+  return std::sqrt(CGAL::squared_area(mesh.point(mesh.source(h)), mesh.point(mesh.target(h)),
+                                      mesh.point(mesh.target(mesh.next(h)))));
+}
+
+// The faces of `mesh` as V/F with their own vertices, in the order given.
+Mesh faces_as_mesh(const SurfaceMesh& mesh, const std::vector<FaceIndex>& faces) {
+  std::vector<Index> index(mesh.num_vertices(), -1);
+  std::vector<VertexIndex> order;
+  Mesh out;
+  out.F.resize(static_cast<Index>(faces.size()), 3);
+  for (std::size_t i = 0; i < faces.size(); ++i) {
+    int k = 0;
+    for (const VertexIndex v : CGAL::vertices_around_face(mesh.halfedge(faces[i]), mesh)) {
+      if (index[v.idx()] < 0) {
+        index[v.idx()] = static_cast<Index>(order.size());
+        order.push_back(v);
+      }
+      out.F(static_cast<Index>(i), k++) = index[v.idx()];
+    }
+  }
+  out.V.resize(static_cast<Index>(order.size()), 3);
+  for (std::size_t i = 0; i < order.size(); ++i) {
+    const auto& p = mesh.point(order[i]);
+    out.V.row(static_cast<Index>(i)) << p.x(), p.y(), p.z();
+  }
+  return out;
+}
+
+// Takes the connected pieces (through edges) whose bounding-box diagonal is below
+// options.small_piece_edges target lengths out of `mesh`: CGAL can only collapse such a piece
+// into one or a few faces of any shape (docs/remesh.md). Returns them as V/F when they are
+// kept. When every piece is that small, the input is smaller than the edge length and is
+// remeshed whole rather than left empty.
+Mesh take_small_pieces(SurfaceMesh& mesh, double edge_length, const IsotropicRemeshOptions& options,
+                       RemeshCleanup& cleanup) {
+  if (options.small_piece_edges == 0) return {};
+  std::vector<int> piece(mesh.num_faces(), -1);
+  std::vector<FaceIndex> stack;
+  std::vector<std::vector<FaceIndex>> pieces;
+  for (const FaceIndex seed : mesh.faces()) {
+    if (piece[seed.idx()] >= 0) continue;
+    const int id = static_cast<int>(pieces.size());
+    pieces.emplace_back();
+    piece[seed.idx()] = id;
+    stack.assign(1, seed);
+    while (!stack.empty()) {
+      const FaceIndex f = stack.back();
+      stack.pop_back();
+      pieces.back().push_back(f);
+      for (const HalfedgeIndex h : CGAL::halfedges_around_face(mesh.halfedge(f), mesh)) {
+        const FaceIndex g = mesh.face(mesh.opposite(h));
+        if (g != SurfaceMesh::null_face() && piece[g.idx()] < 0) {
+          piece[g.idx()] = id;
+          stack.push_back(g);
+        }
+      }
+    }
+  }
+  std::vector<FaceIndex> small;
+  Index small_count = 0;
+  for (const auto& faces : pieces) {
+    Eigen::AlignedBox3d box;
+    for (const FaceIndex f : faces)
+      for (const VertexIndex v : CGAL::vertices_around_face(mesh.halfedge(f), mesh)) {
+        const auto& p = mesh.point(v);
+        box.extend(Eigen::Vector3d(p.x(), p.y(), p.z()));
+      }
+    if (box.diagonal().norm() < options.small_piece_edges * edge_length) {
+      small.insert(small.end(), faces.begin(), faces.end());
+      ++small_count;
+    }
+  }
+  if (small.empty() || small_count == static_cast<Index>(pieces.size())) return {};
+  std::sort(small.begin(), small.end());
+  cleanup.small_pieces = small_count;
+  cleanup.small_piece_faces = static_cast<Index>(small.size());
+  cleanup.small_pieces_kept = options.small_pieces == SmallPieces::keep;
+  Mesh kept;
+  if (cleanup.small_pieces_kept) kept = faces_as_mesh(mesh, small);
+  for (const FaceIndex f : small) CGAL::Euler::remove_face(mesh.halfedge(f), mesh);
+  mesh.collect_garbage();
+  return kept;
+}
+
+// Marks the vertices that keep the boundary loops shorter than options.short_loop_edges target
+// lengths: CGAL would collapse such a loop into a triangle of short edges, or pinch it against
+// a neighbouring loop, leaving needles and zero-area faces. About one vertex per half target
+// length (at least 3, at most all) is held at its input position, chosen at even arc lengths.
+void hold_short_loops(const SurfaceMesh& mesh, double edge_length, const IsotropicRemeshOptions& options,
+                      SurfaceMesh::Property_map<VertexIndex, bool>& held, RemeshCleanup& cleanup) {
+  if (options.short_loop_edges == 0) return;
+  std::vector<char> visited(mesh.num_halfedges(), 0);
+  std::vector<HalfedgeIndex> loop;
+  std::vector<double> arc;
+  for (const HalfedgeIndex start : mesh.halfedges()) {
+    if (!mesh.is_border(start) || visited[start.idx()]) continue;
+    loop.clear();
+    arc.assign(1, 0.0);
+    HalfedgeIndex h = start;
+    do {
+      visited[h.idx()] = 1;
+      loop.push_back(h);
+      arc.push_back(arc.back() + length(mesh, h));
+      h = mesh.next(h);
+    } while (h != start);
+    const double perimeter = arc.back();
+    if (!(perimeter < options.short_loop_edges * edge_length)) continue;
+    const std::size_t n = loop.size();
+    const std::size_t wanted = std::clamp<std::size_t>(static_cast<std::size_t>(2.0 * perimeter / edge_length), 3, n);
+    std::size_t i = 0;
+    for (std::size_t k = 0; k < wanted; ++k) {
+      // The first vertex at or past arc length k P / wanted, leaving enough for the others.
+      const double at = perimeter * static_cast<double>(k) / static_cast<double>(wanted);
+      while (i < n && arc[i] < at) ++i;
+      i = std::min(i, n - (wanted - k));
+      held[mesh.source(loop[i])] = true;
+      ++i;
+    }
+    ++cleanup.short_loops;
+    cleanup.held_loop_vertices += static_cast<Index>(wanted);
+  }
+}
+
+// Whether collapsing e keeps the mesh manifold: CGAL's link condition, and not an interior
+// edge between two boundary vertices (that would pinch).
+bool can_collapse(const SurfaceMesh& mesh, EdgeIndex e) {
+  const HalfedgeIndex h = mesh.halfedge(e);
+  if (!mesh.is_border(e) && mesh.is_border(mesh.source(h)) && mesh.is_border(mesh.target(h))) return false;
+  return CGAL::Euler::does_satisfy_link_condition(e, mesh);
+}
+
+// Collapses e, keeping a boundary endpoint where it is (the boundary stays on the input's rim),
+// otherwise the midpoint.
+void collapse(SurfaceMesh& mesh, EdgeIndex e) {
+  const HalfedgeIndex h = mesh.halfedge(e);
+  const VertexIndex a = mesh.source(h), b = mesh.target(h);
+  const auto pa = mesh.point(a), pb = mesh.point(b);
+  const bool border_a = mesh.is_border(a), border_b = mesh.is_border(b);
+  const auto point = border_a && !border_b ? pa : border_b && !border_a ? pb : CGAL::midpoint(pa, pb);
+  const VertexIndex kept = CGAL::Euler::collapse_edge(e, mesh);
+  mesh.point(kept) = point;
+}
+
+// What CGAL's collapses can leave between close rims, which the other stages refuse: edges
+// shorter than kMinEdgeFraction target lengths (collapsed) and faces of (almost) zero area
+// without such an edge, caps (their longest edge flipped, or the face removed when that edge is
+// on the boundary; a pinch this leaves is duplicated by from_surface_mesh). Touches nothing on
+// a mesh without either, so clean remeshes are unchanged.
+void repair_result(SurfaceMesh& mesh, double edge_length, RemeshCleanup& cleanup) {
+  const double min_edge = kMinEdgeFraction * edge_length;
+  Eigen::AlignedBox3d box;
+  for (const VertexIndex v : mesh.vertices()) {
+    const auto& p = mesh.point(v);
+    box.extend(Eigen::Vector3d(p.x(), p.y(), p.z()));
+  }
+  const double min_area = kCapAreaMargin * kDegenerateAreaRelative * box.diagonal().squaredNorm();
+  for (int round = 0; round < 10; ++round) {
+    bool changed = false;
+    for (const EdgeIndex e : mesh.edges()) {
+      if (mesh.is_removed(e) || !(length(mesh, mesh.halfedge(e)) < min_edge) || !can_collapse(mesh, e)) continue;
+      collapse(mesh, e);
+      ++cleanup.collapsed_short_edges;
+      changed = true;
+    }
+    for (const FaceIndex f : mesh.faces()) {
+      if (mesh.is_removed(f) || !(area(mesh, f) < min_area)) continue;
+      HalfedgeIndex longest = mesh.halfedge(f);
+      for (const HalfedgeIndex h : CGAL::halfedges_around_face(mesh.halfedge(f), mesh))
+        if (length(mesh, h) > length(mesh, longest)) longest = h;
+      const HalfedgeIndex opposite = mesh.opposite(longest);
+      if (mesh.is_border(opposite)) {
+        CGAL::Euler::remove_face(longest, mesh);
+        ++cleanup.removed_cap_faces;
+        changed = true;
+        continue;
+      }
+      // A flip is possible when the two apexes are not joined already.
+      const VertexIndex apex = mesh.target(mesh.next(longest)), other = mesh.target(mesh.next(opposite));
+      if (apex != other && !CGAL::halfedge(apex, other, mesh).second) {
+        CGAL::Euler::flip_edge(longest, mesh);
+        ++cleanup.flipped_cap_edges;
+        changed = true;
+      }
+    }
+    if (!changed) break;
+  }
 }
 
 // Remeshes a copy of `input`, so every attempt starts from (and projects onto) the input.
-Mesh run(SurfaceMesh mesh, double edge_length, const IsotropicRemeshOptions& options, SurfaceRepairs& repairs) {
-  PMP::isotropic_remeshing(faces(mesh), edge_length, mesh,
-                           CGAL::parameters::number_of_iterations(static_cast<unsigned>(options.iterations))
-                               .number_of_relaxation_steps(static_cast<unsigned>(options.relaxation_steps))
-                               .protect_constraints(options.protect_boundary));
-  return remesh_detail::from_surface_mesh(mesh, &repairs);
+Mesh run(SurfaceMesh mesh, double edge_length, const IsotropicRemeshOptions& options, SurfaceRepairs& repairs,
+         RemeshCleanup& cleanup) {
+  cleanup = {};
+  const Mesh kept = take_small_pieces(mesh, edge_length, options, cleanup);
+  auto held = mesh.add_property_map<VertexIndex, bool>("v:vertexflow_held", false).first;
+  hold_short_loops(mesh, edge_length, options, held, cleanup);
+  const auto parameters = CGAL::parameters::number_of_iterations(static_cast<unsigned>(options.iterations))
+                              .number_of_relaxation_steps(static_cast<unsigned>(options.relaxation_steps))
+                              .protect_constraints(options.protect_boundary);
+  if (cleanup.short_loops > 0)
+    PMP::isotropic_remeshing(faces(mesh), edge_length, mesh, parameters.vertex_is_constrained_map(held));
+  else
+    PMP::isotropic_remeshing(faces(mesh), edge_length, mesh, parameters);
+  mesh.remove_property_map(held);
+  repair_result(mesh, edge_length, cleanup);
+  Mesh out = remesh_detail::from_surface_mesh(mesh, &repairs);
+  if (kept.num_faces() > 0) {
+    // Appended after the remeshed faces, unchanged.
+    const Index n = out.num_vertices(), m = out.num_faces();
+    out.V.conservativeResize(n + kept.num_vertices(), 3);
+    out.V.bottomRows(kept.num_vertices()) = kept.V;
+    out.F.conservativeResize(m + kept.num_faces(), 3);
+    out.F.bottomRows(kept.num_faces()) = kept.F.array() + n;
+  }
+  return out;
 }
 
 // CGAL collapses an edge only while it is shorter than 4/5 of the target and splits it once it
@@ -70,15 +303,56 @@ void check_vertex_estimate(double area, double edge_length) {
 
 Mesh remesh_isotropic(const Vertices& V, const Faces& F, double edge_length, const IsotropicRemeshOptions& options,
                       SurfaceRepairs* repairs) {
+  RemeshResult result = remesh_to_edge_length(V, F, edge_length, options);
+  if (repairs) *repairs = result.report.repairs;
+  return std::move(result.mesh);
+}
+
+RemeshResult remesh_to_edge_length(const Vertices& V, const Faces& F, double edge_length,
+                                   const IsotropicRemeshOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
   if (!(edge_length > 0) || !std::isfinite(edge_length))
     throw std::invalid_argument("remesh: the target edge length must be positive");
   check_options(options);
-  SurfaceRepairs counts;
-  SurfaceMesh mesh = remesh_detail::to_surface_mesh(V, F, "remesh", &counts.input_split);
+  RemeshResult result;
+  RemeshReport& r = result.report;
+  SurfaceMesh mesh = remesh_detail::to_surface_mesh(V, F, "remesh", &r.repairs.input_split);
   check_vertex_estimate(surface_area(V, F), edge_length);
-  Mesh out = run(std::move(mesh), edge_length, options, counts);
-  if (repairs) *repairs = counts;
-  return out;
+  result.mesh = run(std::move(mesh), edge_length, options, r.repairs, r.cleanup);
+  r.seconds = seconds_since(start);
+  r.attempts.push_back({edge_length, result.mesh.num_vertices(), r.seconds});
+  r.edge_length = edge_length;
+  r.within_tolerance = true;
+  r.quality = remesh_quality(result.mesh.V, result.mesh.F);
+  return result;
+}
+
+RemeshQuality remesh_quality(const Vertices& V, const Faces& F) {
+  RemeshQuality q;
+  const Topology topology = build_topology(F, static_cast<Index>(V.rows()));
+  const Eigen::VectorXd quality = triangle_quality(V, F);
+  std::vector<double> interior, rim;
+  for (Index f = 0; f < F.rows(); ++f) {
+    bool on_rim = false;
+    for (int k = 0; k < 3; ++k) on_rim = on_rim || topology.is_boundary_vertex[static_cast<std::size_t>(F(f, k))];
+    (on_rim ? rim : interior).push_back(quality(f));
+  }
+  const auto stats = [](const std::vector<double>& values) {
+    return summarize_quality(Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Index>(values.size())));
+  };
+  q.all = summarize_quality(quality);
+  q.interior = stats(interior);
+  q.rim = stats(rim);
+  q.interior_faces = static_cast<Index>(interior.size());
+  q.rim_faces = static_cast<Index>(rim.size());
+  q.components = topology.num_components;
+  q.boundary_loops = static_cast<Index>(topology.boundary_loops.size());
+  q.non_manifold_vertices = static_cast<Index>(topology.non_manifold_vertices.size());
+  q.zero_area_faces = static_cast<Index>(degenerate_faces(V, F).size());
+  q.min_edge_length = topology.num_edges() > 0 ? std::numeric_limits<double>::infinity() : 0.0;
+  for (Index e = 0; e < topology.num_edges(); ++e)
+    q.min_edge_length = std::min(q.min_edge_length, (V.row(topology.edges(e, 0)) - V.row(topology.edges(e, 1))).norm());
+  return q;
 }
 
 double edge_length_for_vertex_count(double area, Index vertices) {
@@ -104,7 +378,8 @@ RemeshResult remesh_to_vertex_count(const Vertices& V, const Faces& F, const Rem
     check_vertex_estimate(area, length);
     const auto attempt_start = std::chrono::steady_clock::now();
     SurfaceRepairs repairs{input_split, 0, 0};
-    Mesh mesh = run(input, length, options.isotropic, repairs);
+    RemeshCleanup cleanup;
+    Mesh mesh = run(input, length, options.isotropic, repairs, cleanup);
     const Index count = mesh.num_vertices();
     best.report.attempts.push_back({length, count, seconds_since(attempt_start)});
     const double error = std::abs(count - target);
@@ -113,6 +388,7 @@ RemeshResult remesh_to_vertex_count(const Vertices& V, const Faces& F, const Rem
       best.mesh = std::move(mesh);
       best.report.edge_length = length;
       best.report.repairs = repairs;
+      best.report.cleanup = cleanup;
     }
     if (error <= options.tolerance * target || count == 0) break;
     // #V ~ c L^-p. Once runs on both sides of the target are known, interpolate between the
@@ -145,6 +421,7 @@ RemeshResult remesh_to_vertex_count(const Vertices& V, const Faces& F, const Rem
     length *= std::pow(count / target, 1.0 / p);
   }
   best.report.within_tolerance = best_error <= options.tolerance * target;
+  best.report.quality = remesh_quality(best.mesh.V, best.mesh.F);
   best.report.seconds = seconds_since(start);
   return best;
 }

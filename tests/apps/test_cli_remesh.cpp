@@ -1,5 +1,6 @@
 // `vertexflow simplify`, `vertexflow remesh` and `vertexflow enhance --method unsharp` end to end:
 // outputs, JSON, one-line errors with exit code 1, no output written on failure.
+#include "raw_scan.h"
 #include "test_support.h"
 
 #include "vertexflow/io.h"
@@ -9,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include <fstream>
+#include <sstream>
 
 namespace vertexflow {
 namespace {
@@ -119,6 +121,65 @@ TEST(CliRemeshAndSimplify, NonManifoldInputIsSplitWithAWarning) {
     const Mesh result = read_mesh(out);
     test::expect_clean_surface(result);
   }
+}
+
+// Issue 31: a raw scan (raw_scan.h, from bunny.off) remeshed with the pieces too small to remesh
+// counted in a warning and in --json, the quality over interior and rim faces reported, and the
+// result taken by enhance in every mode without a flipped face.
+TEST(CliRemesh, RawScanIsRemeshedCleanAndEnhancedInEveryMode) {
+  test::ScratchDir dir("cli-remesh-raw-scan");
+  const auto scan = dir.file("raw.ply");
+  write_mesh(scan, test::make_raw_scan(read_mesh(test::data_path("bunny.off"))).mesh);
+  const auto out = dir.file("remesh.ply");
+  const auto r = run_cli("remesh " + shell_quote(scan.string()) + " " + shell_quote(out.string()) +
+                         " --target-vertices 6000 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  const Index pieces = j["cleanup"]["small_pieces"];
+  EXPECT_GE(pieces, 80);  // measured 105
+  EXPECT_EQ(j["cleanup"]["small_pieces_kept"], false);
+  EXPECT_NE(r.err.find("vertexflow: warning: " + scan.string() + ": " + std::to_string(pieces) + " pieces ("),
+            std::string::npos)
+      << r.err;
+  EXPECT_NE(r.err.find("too small to remesh: removed"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("interior faces"), std::string::npos) << r.err;
+  EXPECT_GT(j["cleanup"]["short_loops_kept"].get<Index>(), 0);
+  EXPECT_LE(j["quality_interior"]["fraction_below_0_3"].get<double>(), 0.02);
+  EXPECT_TRUE(j["quality_rim"].contains("fraction_below_0_3"));
+  EXPECT_EQ(j["interior_faces"].get<Index>() + j["rim_faces"].get<Index>(), j["faces"].get<Index>());
+  EXPECT_EQ(j["zero_area_faces"], 0);
+  EXPECT_EQ(j["non_manifold_vertices"], 0);
+  EXPECT_GE(j["min_edge_length"].get<double>(), 1e-4 * j["edge_length"].get<double>());
+  const Mesh result = read_mesh(out);
+  test::expect_clean_surface(result);
+  EXPECT_EQ(j["components"], build_topology(result.F, result.num_vertices()).num_components);
+
+  for (const std::string& mode :
+       std::vector<std::string>{"", "--density-passes 3", "--method unsharp", "--surface smooth",
+                                "--reference " + shell_quote(scan.string())}) {
+    const auto report = dir.file("report.json");
+    const auto e =
+        run_cli("--quiet enhance " + shell_quote(out.string()) + " " + shell_quote(dir.file("enhanced.ply").string()) +
+                " " + mode + " --force --report " + shell_quote(report.string()));
+    ASSERT_EQ(e.exit_code, 0) << mode << ": " << e.err;
+    const auto rep = nlohmann::json::parse(test::read_text(report));
+    EXPECT_EQ(rep["flipped_faces"], 0) << mode;
+    if (mode == "--surface smooth") {
+      EXPECT_EQ(rep["fit"]["held_as_decimated"], false);
+    }
+  }
+
+  // --small-pieces keep copies them unchanged, the same count.
+  std::ostringstream length;
+  length.precision(17);
+  length << j["edge_length"].get<double>();
+  const auto keep = run_cli("--quiet remesh " + shell_quote(scan.string()) + " " + shell_quote(out.string()) +
+                            " --edge-length " + length.str() + " --small-pieces keep --force --json");
+  ASSERT_EQ(keep.exit_code, 0) << keep.err;
+  const auto k = nlohmann::json::parse(keep.out);
+  EXPECT_EQ(k["cleanup"]["small_pieces_kept"], true);
+  EXPECT_EQ(k["cleanup"]["small_pieces"], pieces);
+  EXPECT_EQ(k["components"].get<Index>(), j["components"].get<Index>() + pieces);
 }
 
 TEST(CliRemesh, BadInputFailsCleanly) {

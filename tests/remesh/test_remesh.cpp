@@ -1,5 +1,6 @@
 // Isotropic remeshing: the vertex count search, vertices on the input surface (CGAL AABB tree),
 // triangle quality, topology, boundaries resampled along the input's boundary.
+#include "raw_scan.h"
 #include "shapes.h"
 #include "test_support.h"
 
@@ -235,6 +236,237 @@ TEST(Remesh, ScanWithManyHolesGivesACleanMeshTheFlowTakes) {
   EXPECT_GT((flowed.V - result.mesh.V).rowwise().norm().mean(), 0.012 * flowed.report.mean_edge_length);
 }
 
+// Issue 31: the raw-scan input (raw_scan.h) of bunny.off: 320 holes, 120 floating pieces (most
+// smaller than the target edge), slivers on half the holes' rims.
+const test::RawScan& raw_bunny() {
+  static const test::RawScan scan = test::make_raw_scan(read_mesh(test::data_path("bunny.off")));
+  return scan;
+}
+
+// The remesh of the raw scan to 6000 vertices, with the defaults and with the issue 31 handling
+// switched off (every piece remeshed, every loop resampled), as before.
+const RemeshResult& raw_bunny_remesh(bool handled) {
+  static const auto run = [](bool on) {
+    RemeshOptions options;
+    options.target_vertices = 6000;
+    if (!on) {
+      options.isotropic.small_piece_edges = 0;
+      options.isotropic.short_loop_edges = 0;
+    }
+    return remesh_to_vertex_count(raw_bunny().mesh.V, raw_bunny().mesh.F, options);
+  };
+  static const RemeshResult with = run(true), without = run(false);
+  return handled ? with : without;
+}
+
+TEST(RemeshRawScan, TheInputHasTheIssuesProperties) {
+  const test::RawScan& scan = raw_bunny();
+  const Topology topology = build_topology(scan.mesh.F, scan.mesh.num_vertices());
+  std::cout << "[measured] raw bunny: " << topology.num_components << " components, " << topology.boundary_loops.size()
+            << " loops, " << topology.non_manifold_vertices.size() << " non-manifold vertices, " << scan.slivers
+            << " slivers, " << scan.pieces_below_target << " pieces below one target edge\n";
+  EXPECT_EQ(scan.holes, 320);
+  EXPECT_EQ(scan.pieces, 120);
+  EXPECT_GE(scan.pieces_below_target, 50);          // measured 91
+  EXPECT_GE(scan.slivers, 500);                     // measured 1419
+  EXPECT_GE(topology.num_components, 100);          // measured 122 (holes cut some islands off)
+  EXPECT_GE(topology.boundary_loops.size(), 300u);  // measured 355 (holes merge)
+  EXPECT_FALSE(topology.is_manifold());             // holes touching at a vertex: measured 37
+}
+
+// Pieces too small to remesh are removed, and counted; without that CGAL turns each into one
+// face or a few of any shape.
+TEST(RemeshRawScan, SmallPiecesAreRemovedAndCounted) {
+  const RemeshResult& with = raw_bunny_remesh(true);
+  const RemeshResult& without = raw_bunny_remesh(false);
+  const RemeshCleanup& c = with.report.cleanup;
+  std::cout << "[measured] raw bunny -> " << with.mesh.num_vertices() << " vertices: " << c.small_pieces
+            << " small pieces (" << c.small_piece_faces << " faces), " << c.short_loops << " short loops ("
+            << c.held_loop_vertices << " held), collapsed " << c.collapsed_short_edges << ", flipped "
+            << c.flipped_cap_edges << ", removed " << c.removed_cap_faces << "; components "
+            << with.report.quality.components << " (without: " << without.report.quality.components << ")\n";
+  EXPECT_GE(c.small_pieces, 80);  // measured 105
+  EXPECT_FALSE(c.small_pieces_kept);
+  EXPECT_EQ(without.report.cleanup.small_pieces, 0);
+  // Every remaining piece is at least small_piece_edges target edges across: measured 28
+  // components left, 133 without the removal.
+  const Topology topology = build_topology(with.mesh.F, with.mesh.num_vertices());
+  EXPECT_EQ(with.report.quality.components, topology.num_components);
+  // The removed pieces are the components the remesh without the handling has in excess:
+  // measured 28 = 133 - 105 (more than the input's 122 less 105: the manifold split separates
+  // pieces that the input's non-manifold vertices join).
+  EXPECT_LE(topology.num_components, without.report.quality.components - c.small_pieces + 3);
+  std::vector<Eigen::AlignedBox3d> boxes(static_cast<std::size_t>(topology.num_components));
+  for (Index v = 0; v < with.mesh.num_vertices(); ++v)
+    boxes[static_cast<std::size_t>(topology.vertex_component[static_cast<std::size_t>(v)])].extend(
+        with.mesh.V.row(v).transpose());
+  for (const auto& box : boxes) EXPECT_GE(box.diagonal().norm(), 1.0 * with.report.edge_length);
+  EXPECT_GE(without.report.quality.components, topology.num_components + 80);  // measured 133 vs 28
+}
+
+TEST(RemeshRawScan, KeptPiecesAreCopiedUnchanged) {
+  const test::RawScan& scan = raw_bunny();
+  IsotropicRemeshOptions options;
+  options.small_pieces = SmallPieces::keep;
+  const double L = raw_bunny_remesh(true).report.edge_length;
+  const RemeshResult kept = remesh_to_edge_length(scan.mesh.V, scan.mesh.F, L, options);
+  options.small_pieces = SmallPieces::remove;
+  const RemeshResult removed = remesh_to_edge_length(scan.mesh.V, scan.mesh.F, L, options);
+  EXPECT_TRUE(kept.report.cleanup.small_pieces_kept);
+  EXPECT_EQ(kept.report.cleanup.small_pieces, removed.report.cleanup.small_pieces);
+  // The kept faces are appended after the remeshed ones, with their input positions.
+  ASSERT_EQ(kept.mesh.num_faces(), removed.mesh.num_faces() + kept.report.cleanup.small_piece_faces);
+  EXPECT_EQ(kept.mesh.V.topRows(removed.mesh.num_vertices()), removed.mesh.V);
+  std::set<std::array<double, 3>> input;
+  for (Index v = 0; v < scan.mesh.num_vertices(); ++v)
+    input.insert({scan.mesh.V(v, 0), scan.mesh.V(v, 1), scan.mesh.V(v, 2)});
+  for (Index v = removed.mesh.num_vertices(); v < kept.mesh.num_vertices(); ++v)
+    EXPECT_TRUE(input.count({kept.mesh.V(v, 0), kept.mesh.V(v, 1), kept.mesh.V(v, 2)})) << v;
+  EXPECT_EQ(kept.report.quality.components, removed.report.quality.components + kept.report.cleanup.small_pieces);
+}
+
+// The acceptance of issue 31 on the raw scan: manifold, no zero-area face, no edge below 1e-4
+// target edges, at most 2 % of the interior faces below quality 0.3; the report's quality is
+// that of the mesh returned. Without the handling the same input gives 1-face components and
+// edges of 0.03 target edges.
+TEST(RemeshRawScan, GivesACleanMeshWithGoodInteriorQuality) {
+  const RemeshResult& with = raw_bunny_remesh(true);
+  const RemeshReport& r = with.report;
+  std::cout << "[measured] quality below 0.3: interior " << r.quality.interior.fraction_below_0_3 << " of "
+            << r.quality.interior_faces << ", rim " << r.quality.rim.fraction_below_0_3 << " of " << r.quality.rim_faces
+            << "; min edge " << r.quality.min_edge_length / r.edge_length << " L; loops " << r.quality.boundary_loops
+            << "\n";
+  test::expect_clean_surface(with.mesh);
+  EXPECT_EQ(r.quality.zero_area_faces, 0);
+  EXPECT_EQ(r.quality.non_manifold_vertices, 0);
+  EXPECT_GE(r.quality.min_edge_length, 1e-4 * r.edge_length);
+  EXPECT_LE(r.quality.interior.fraction_below_0_3, 0.02);  // measured 0
+  EXPECT_TRUE(r.within_tolerance);
+  // The report describes the result.
+  const Topology topology = build_topology(with.mesh.F, with.mesh.num_vertices());
+  EXPECT_EQ(r.quality.boundary_loops, static_cast<Index>(topology.boundary_loops.size()));
+  EXPECT_EQ(r.quality.interior_faces + r.quality.rim_faces, with.mesh.num_faces());
+  EXPECT_EQ(r.quality.all.fraction_below_0_3,
+            summarize_quality(triangle_quality(with.mesh.V, with.mesh.F)).fraction_below_0_3);
+  double min_edge = std::numeric_limits<double>::infinity();
+  for (Index e = 0; e < topology.num_edges(); ++e)
+    min_edge =
+        std::min(min_edge, (with.mesh.V.row(topology.edges(e, 0)) - with.mesh.V.row(topology.edges(e, 1))).norm());
+  EXPECT_EQ(r.quality.min_edge_length, min_edge);
+  // Vertices on the input surface (pieces removed, the rest projected).
+  EXPECT_LT(max_distance_to_surface(with.mesh.V, raw_bunny().mesh), 1e-9 * bounding_box(with.mesh.V).diagonal());
+
+  const RemeshReport& before = raw_bunny_remesh(false).report;
+  std::cout << "[measured] without the handling: components " << before.quality.components << ", min edge "
+            << before.quality.min_edge_length / before.edge_length << " L, below 0.3 "
+            << before.quality.all.fraction_below_0_3 << "\n";
+  EXPECT_LT(before.quality.min_edge_length, 0.05 * before.edge_length);  // measured 0.033
+  EXPECT_GT(r.quality.min_edge_length, 0.05 * r.edge_length);            // measured 0.07
+}
+
+// A boundary loop shorter than short_loop_edges target edges keeps vertices at its input
+// positions (about one per half target edge, at least 3) instead of being collapsed.
+TEST(RemeshRawScan, ShortLoopsAreKept) {
+  // A unit sphere with one small hole: the faces within 0.06 of the north pole removed.
+  const Mesh sphere = test::icosphere(1.0, 5);
+  std::vector<Index> kept_faces;
+  for (Index f = 0; f < sphere.num_faces(); ++f) {
+    bool near = false;
+    for (int k = 0; k < 3; ++k)
+      near = near || (sphere.V.row(sphere.F(f, k)) - Eigen::RowVector3d(0, 0, 1)).norm() < 0.06;
+    if (!near) kept_faces.push_back(f);
+  }
+  Mesh holed;
+  holed.V = sphere.V;
+  holed.F.resize(static_cast<Index>(kept_faces.size()), 3);
+  for (std::size_t i = 0; i < kept_faces.size(); ++i) holed.F.row(static_cast<Index>(i)) = sphere.F.row(kept_faces[i]);
+  const Topology input = build_topology(holed.F, holed.num_vertices());
+  ASSERT_EQ(input.boundary_loops.size(), 1u);
+  double perimeter = 0;
+  const std::vector<Index>& loop = input.boundary_loops.front();
+  for (std::size_t i = 0; i < loop.size(); ++i)
+    perimeter += (holed.V.row(loop[i]) - holed.V.row(loop[(i + 1) % loop.size()])).norm();
+  const double L = 0.2;  // the loop is about 2.3 L long (measured 0.454), of 12 input edges
+  ASSERT_LT(perimeter, 3 * L);
+  std::set<std::array<double, 3>> rim;
+  for (const Index v : loop) rim.insert({holed.V(v, 0), holed.V(v, 1), holed.V(v, 2)});
+
+  const RemeshResult with = remesh_to_edge_length(holed.V, holed.F, L);
+  EXPECT_EQ(with.report.cleanup.short_loops, 1);
+  EXPECT_EQ(with.report.cleanup.held_loop_vertices, std::max<Index>(3, static_cast<Index>(2 * perimeter / L)));
+  const Topology output = build_topology(with.mesh.F, with.mesh.num_vertices());
+  ASSERT_EQ(output.boundary_loops.size(), 1u);
+  Index on_rim = 0;
+  for (const Index v : output.boundary_loops.front())
+    on_rim += rim.count({with.mesh.V(v, 0), with.mesh.V(v, 1), with.mesh.V(v, 2)}) ? 1 : 0;
+  std::cout << "[measured] hole of perimeter " << perimeter << ": loop of " << output.boundary_loops.front().size()
+            << " vertices, " << on_rim << " at input rim vertices\n";
+  EXPECT_GE(on_rim, with.report.cleanup.held_loop_vertices);
+
+  IsotropicRemeshOptions off;
+  off.short_loop_edges = 0;
+  const RemeshResult without = remesh_to_edge_length(holed.V, holed.F, L, off);
+  EXPECT_EQ(without.report.cleanup.short_loops, 0);
+  const Topology collapsed = build_topology(without.mesh.F, without.mesh.num_vertices());
+  ASSERT_EQ(collapsed.boundary_loops.size(), 1u);
+  std::cout << "[measured] resampled instead: loop of " << collapsed.boundary_loops.front().size() << " vertices\n";
+  EXPECT_LT(collapsed.boundary_loops.front().size(), output.boundary_loops.front().size());
+}
+
+// An edge shorter than 1e-4 target edges left in the result (here a protected boundary edge of
+// 1e-6 of its input length) is collapsed; without that the result would keep it.
+TEST(RemeshRawScan, EdgesFarBelowTheTargetAreCollapsed) {
+  Mesh mesh = read_mesh(test::data_path("hemisphere.off"));
+  const Topology topology = build_topology(mesh.F, mesh.num_vertices());
+  // The face on the boundary edge a -> b gets a vertex p at 1e-6 of the way from a to b.
+  const std::vector<Index>& loop = topology.boundary_loops.front();
+  const Index a = loop[1], b = loop[0];  // loops run against their faces' edges
+  Index face = -1, corner = -1;
+  for (Index f = 0; f < mesh.num_faces() && face < 0; ++f)
+    for (int k = 0; k < 3; ++k)
+      if (mesh.F(f, k) == a && mesh.F(f, (k + 1) % 3) == b) face = f, corner = k;
+  ASSERT_GE(face, 0);
+  const Index c = mesh.F(face, (corner + 2) % 3), p = mesh.num_vertices();
+  mesh.V.conservativeResize(p + 1, 3);
+  mesh.V.row(p) = mesh.V.row(a) + 1e-6 * (mesh.V.row(b) - mesh.V.row(a));
+  mesh.F.row(face) << a, p, c;
+  mesh.F.conservativeResize(mesh.num_faces() + 1, 3);
+  mesh.F.row(mesh.num_faces() - 1) << p, b, c;
+  IsotropicRemeshOptions options;
+  options.protect_boundary = true;
+  const double L = 1.2 * mean_edge_length(mesh.V, topology);
+  const RemeshResult result = remesh_to_edge_length(mesh.V, mesh.F, L, options);
+  EXPECT_GE(result.report.cleanup.collapsed_short_edges, 1);
+  EXPECT_GE(result.report.quality.min_edge_length, 1e-4 * L);
+  test::expect_clean_surface(result.mesh);
+  EXPECT_EQ(build_topology(result.mesh.F, result.mesh.num_vertices()).boundary_loops.size(), 1u);
+}
+
+TEST(RemeshRawScan, QualityIsSplitIntoRimAndInteriorFaces) {
+  const Mesh hemisphere = read_mesh(test::data_path("hemisphere.off"));
+  const RemeshQuality q = remesh_quality(hemisphere.V, hemisphere.F);
+  const Topology topology = build_topology(hemisphere.F, hemisphere.num_vertices());
+  Index rim = 0;
+  for (Index f = 0; f < hemisphere.num_faces(); ++f)
+    rim += topology.is_boundary_vertex[static_cast<std::size_t>(hemisphere.F(f, 0))] ||
+                   topology.is_boundary_vertex[static_cast<std::size_t>(hemisphere.F(f, 1))] ||
+                   topology.is_boundary_vertex[static_cast<std::size_t>(hemisphere.F(f, 2))]
+               ? 1
+               : 0;
+  EXPECT_GT(rim, 0);
+  EXPECT_EQ(q.rim_faces, rim);
+  EXPECT_EQ(q.interior_faces, hemisphere.num_faces() - rim);
+  EXPECT_EQ(q.boundary_loops, 1);
+  EXPECT_EQ(q.components, 1);
+  EXPECT_EQ(q.zero_area_faces, 0);
+  // A closed mesh has no rim faces.
+  const Mesh sphere = test::icosphere(1.0, 2);
+  const RemeshQuality closed = remesh_quality(sphere.V, sphere.F);
+  EXPECT_EQ(closed.rim_faces, 0);
+  EXPECT_EQ(closed.interior_faces, sphere.num_faces());
+  EXPECT_EQ(closed.interior.mean, closed.all.mean);
+}
+
 TEST(Remesh, NonManifoldInputIsRemeshedThroughItsSplit) {
   const Mesh bowtie = test::bowtie();
   SurfaceRepairs repairs;
@@ -254,6 +486,12 @@ TEST(Remesh, RefusesBadInputAndOptions) {
   } catch (const std::invalid_argument& e) {
     EXPECT_NE(std::string(e.what()).find("(at most 50 million)"), std::string::npos) << e.what();
   }
+  IsotropicRemeshOptions bad;
+  bad.small_piece_edges = -1;
+  EXPECT_THROW(remesh_isotropic(sphere.V, sphere.F, 0.1, bad), std::invalid_argument);
+  bad = {};
+  bad.short_loop_edges = std::nan("");
+  EXPECT_THROW(remesh_to_edge_length(sphere.V, sphere.F, 0.1, bad), std::invalid_argument);
   RemeshOptions options;
   options.target_vertices = 0;
   EXPECT_THROW(remesh_to_vertex_count(sphere.V, sphere.F, options), std::invalid_argument);
