@@ -220,6 +220,7 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     if (reference) {
       report["reference"] = o->reference_file;
       report["reference_trees_built"] = distance_trees_built(reference->faces().rows()) - trees_before;
+      report["reference_memory_bytes"] = reference->memory_bytes();  // now with the metrics' samples
     }
     // The whole process's peak so far (the run, and the metrics above).
     report["peak_memory_bytes"] = peak_resident_bytes();

@@ -29,6 +29,7 @@
 
 #include "vertexflow/mesh.h"
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -127,6 +128,10 @@ class DistanceQuery {
   /// B's vertices and faces (the copy the tree was built from, or the borrowed ones).
   [[nodiscard]] const Vertices& vertices() const;
   [[nodiscard]] const Faces& faces() const;
+
+  /// The bytes this query holds: its trees' nodes and primitives (about 68 per face), and its
+  /// copy of B's V and F unless they are borrowed. Borrowed V and F are not counted.
+  [[nodiscard]] std::size_t memory_bytes() const;
 
  private:
   struct Impl;

@@ -140,7 +140,9 @@ struct EnhanceResult {
   /// guard, fit, non_manifold, ...), "seconds" of its phases, "edge_flips", "provenance", and
   /// "reference_trees_built" in the reference modes (the trees over the reference's faces this
   /// run built: 1 for the fit with its flips and refits; the flow on S builds its own, in its
-  /// normalised units, and a report's distances then build the ReferenceSurface's). The front ends add the files, the
+  /// normalised units, and a report's distances then build the ReferenceSurface's), and
+  /// "reference_memory_bytes" (what the ReferenceSurface holds after the run: its V and F, its
+  /// tree and samples; ReferenceSurface::memory_bytes). The front ends add the files, the
   /// read and write times and the metrics (enhance_metrics).
   nlohmann::json report;
   /// This run's provenance line (also the last of mesh.comments).

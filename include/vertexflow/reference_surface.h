@@ -16,6 +16,7 @@
 #include "vertexflow/distance.h"
 #include "vertexflow/mesh.h"
 
+#include <cstddef>
 #include <memory>
 #include <string>
 
@@ -46,6 +47,10 @@ class ReferenceSurface {
   /// How many times S's tree has been built (1 after any use, 0 before): what the reports
   /// record as reference_trees_built, and what the tests hold at 1.
   [[nodiscard]] int trees_built() const;
+
+  /// The bytes S holds now: its V and F, its tree once built (DistanceQuery::memory_bytes) and
+  /// the samples drawn so far. What reports record as reference_memory_bytes.
+  [[nodiscard]] std::size_t memory_bytes() const;
 
  private:
   struct Impl;

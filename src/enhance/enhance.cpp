@@ -494,7 +494,11 @@ EnhanceResult enhance_clean(const Mesh& mesh, const ReferenceSurface* reference,
   append_provenance(out.comments, result.provenance);
   run.report["provenance"] = result.provenance;
   run.report["method"] = enhance_mode_name(mode);
-  if (reference) run.report["reference_trees_built"] = distance_trees_built(reference->faces().rows()) - trees_before;
+  if (reference) {
+    run.report["reference_trees_built"] = distance_trees_built(reference->faces().rows()) - trees_before;
+    // What S holds after the run: V, F, its tree and samples (reference_surface.h).
+    run.report["reference_memory_bytes"] = reference->memory_bytes();
+  }
   result.report = std::move(run.report);
   return result;
 }

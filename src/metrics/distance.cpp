@@ -454,6 +454,17 @@ DistanceQuery::~DistanceQuery() = default;
 DistanceQuery::DistanceQuery(DistanceQuery&&) noexcept = default;
 DistanceQuery& DistanceQuery::operator=(DistanceQuery&&) noexcept = default;
 
+std::size_t DistanceQuery::memory_bytes() const {
+  // An AABB_tree of n primitives holds them in one vector and n - 1 nodes in another (CGAL 5.5).
+  using Node = CGAL::AABB_node<CGAL::AABB_traits<Kernel, FacePrimitive>>;
+  std::size_t bytes = sizeof(Impl) + impl_->trees.size() * sizeof(Tree);
+  for (const Tree& tree : impl_->trees)
+    bytes += tree.size() * sizeof(FacePrimitive) + (tree.size() > 0 ? tree.size() - 1 : 0) * sizeof(Node);
+  bytes += static_cast<std::size_t>(impl_->own_V.size()) * sizeof(double) +
+           static_cast<std::size_t>(impl_->own_F.size()) * sizeof(Index);
+  return bytes;
+}
+
 const Vertices& DistanceQuery::vertices() const {
   return *impl_->mesh.V;
 }

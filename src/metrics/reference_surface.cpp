@@ -71,4 +71,14 @@ int ReferenceSurface::trees_built() const {
   return impl_->trees_built.load();
 }
 
+std::size_t ReferenceSurface::memory_bytes() const {
+  std::size_t bytes = static_cast<std::size_t>(impl_->V.size()) * sizeof(double) +
+                      static_cast<std::size_t>(impl_->F.size()) * sizeof(Index);
+  if (impl_->trees_built.load() > 0) bytes += impl_->tree->memory_bytes();
+  const std::lock_guard lock(impl_->samples_mutex);
+  for (const auto& [key, drawn] : impl_->samples)
+    bytes += static_cast<std::size_t>(drawn.points.size()) * sizeof(double);
+  return bytes;
+}
+
 }  // namespace vertexflow

@@ -4,6 +4,7 @@
 
 #include "vertexflow/distance.h"
 #include "vertexflow/io.h"
+#include "vertexflow/reference_surface.h"
 #include "vertexflow/topology.h"
 
 #include <gtest/gtest.h>
@@ -153,6 +154,35 @@ TEST(DistanceQuery, BorrowedMeshGivesTheSameAnswers) {
     }
     EXPECT_EQ(copied.max_squared_distance(P), borrowed.max_squared_distance(P));
   }
+}
+
+// What a query reports it holds (issue 29: the reference's memory is reported): its trees, at
+// 68 bytes per face on this build (CGAL 5.5: a 4-byte primitive and a 64-byte node per face),
+// plus its own copy of V and F, which a borrowing query does not count; and a reference
+// surface adds its tree and samples once they exist.
+TEST(DistanceQuery, ReportsTheMemoryItHolds) {
+  for (const Mesh& mesh : {test::icosphere(1.0, 3), test::torus(1.0, 0.3, 500, 201)}) {
+    const DistanceQuery copied(mesh.V, mesh.F);
+    const DistanceQuery borrowed(mesh.V, mesh.F, DistanceQuery::Borrow{});
+    const double per_face = static_cast<double>(borrowed.memory_bytes()) / static_cast<double>(mesh.num_faces());
+    EXPECT_GT(per_face, 60.0);
+    EXPECT_LT(per_face, 80.0);
+    EXPECT_EQ(copied.memory_bytes() - borrowed.memory_bytes(),
+              static_cast<std::size_t>(mesh.V.size()) * sizeof(double) +
+                  static_cast<std::size_t>(mesh.F.size()) * sizeof(Index));
+  }
+  const Mesh mesh = test::icosphere(1.0, 3);
+  const ReferenceSurface reference(mesh.V, mesh.F);
+  const std::size_t mesh_bytes =
+      static_cast<std::size_t>(mesh.V.size()) * sizeof(double) + static_cast<std::size_t>(mesh.F.size()) * sizeof(Index);
+  EXPECT_EQ(reference.memory_bytes(), mesh_bytes);
+  const std::size_t tree_bytes = reference.distance_query().memory_bytes();
+  EXPECT_EQ(reference.memory_bytes(), mesh_bytes + tree_bytes);
+  SamplingOptions sampling;
+  sampling.samples = 1000;
+  const SurfaceSamples& drawn = reference.samples(sampling);
+  EXPECT_EQ(reference.memory_bytes(),
+            mesh_bytes + tree_bytes + static_cast<std::size_t>(drawn.points.size()) * sizeof(double));
 }
 
 TEST(DistanceQuery, DegenerateTriangleIsItsLongestEdge) {
