@@ -2,6 +2,7 @@
 // glob or manifest, with --jobs files at once, a progress bar with an ETA, resumable, and a
 // summary table (batch.h).
 #include "cli_common.h"
+#include "progress.h"
 
 #include "vertexflow/batch.h"
 
@@ -11,8 +12,6 @@
 #include <memory>
 #include <stdexcept>
 #include <utility>
-
-#include <unistd.h>
 
 namespace vertexflow::cli {
 namespace {
@@ -81,20 +80,22 @@ void register_batch_command(CLI::App& app, const GlobalOptions& global) {
     // flags' words, before any file is read.
     o->batch.naming = OptionNaming::Cli;
     o->batch.file.metrics = !o->no_metrics;
-    const bool tty = ::isatty(STDERR_FILENO) == 1;
+    // On a terminal the progress line (progress.h): files finished of all, the line moving at
+    // the rate of the files so far; the engine's own phases are not shown (several files run at
+    // once), so this thread's reports are silenced.
+    ProgressLine line(global);
+    const ProgressScope engine_reports_silenced{ProgressSink()};
+    const bool tty = line.active();
+    line.report("enhancing files", 0, 0);
     if (!global.quiet) {
       o->batch.warning = [](const std::string& warning) { fmt::print(stderr, "vertexflow: warning: {}\n", warning); };
-      o->batch.progress = [tty](const BatchProgress& p) {
+      o->batch.progress = [tty, &line](const BatchProgress& p) {
         const BatchRow& row = *p.row;
         const std::string eta = p.eta >= 0 ? clock_text(p.eta) : std::string("?");
-        if (tty) fmt::print(stderr, "\r\033[K");
         if (row.status == "failed") fmt::print(stderr, "vertexflow: warning: {}\n", row.error);
         if (tty) {
-          constexpr int width = 30;
-          const int filled = static_cast<int>(width * p.finished / p.total);
-          fmt::print(stderr, "vertexflow: [{}{}] {}/{} files, {} failed, elapsed {}, ETA {}", std::string(filled, '#'),
-                     std::string(width - filled, '.'), p.finished, p.total, p.failed, clock_text(p.elapsed), eta);
-          if (p.finished == p.total) fmt::print(stderr, "\n");
+          line.report(fmt::format("{}/{} files, {} failed", p.finished, p.total, p.failed),
+                      static_cast<double>(p.finished) / p.total, static_cast<double>(p.finished + 1) / p.total);
         } else {
           fmt::print(stderr, "vertexflow: {}/{} {} {} ({:.2f} s), ETA {}\n", p.finished, p.total, row.input, row.status,
                      row.seconds_total, eta);
@@ -102,6 +103,7 @@ void register_batch_command(CLI::App& app, const GlobalOptions& global) {
       };
     }
     const BatchSummary summary = run_batch(o->batch);
+    line.finish();
     if (!global.quiet)
       fmt::print(
           stderr, "vertexflow: {} done, {} skipped (output exists), {} failed in {:.2f} s; summary in {} and {}\n",

@@ -1,6 +1,7 @@
 // `vertexflow compare RESULT INPUT [--reference DENSE] [--json] [--samples N] [--seed S]`: every
 // figure of docs/metrics.md for a result of the flow (compare.h), as a table or as JSON.
 #include "cli_common.h"
+#include "progress.h"
 
 #include "vertexflow/compare.h"
 
@@ -147,16 +148,26 @@ void register_compare_command(CLI::App& app, const GlobalOptions& global) {
       ->capture_default_str();
   command->add_option("--seed", o->seed, "Seed of the sampling")->capture_default_str();
   command->callback([o, &global] {
+    // The progress line on a terminal (progress.h): reading, then the comparison (curvatures,
+    // trees, queries), most of the time; the shares are rough.
+    ProgressLine progress(global);
+    const std::vector<double> part = progress_bounds({3, 3, o->reference.empty() ? 0.0 : 10.0, 100});
+    report_progress("reading " + o->result, part[0], part[1]);
     const Mesh result = read_mesh_with_warnings(o->result, global);
+    report_progress("reading " + o->input, part[1], part[2]);
     const Mesh input = read_mesh_with_warnings(o->input, global);
     Mesh reference;
-    if (!o->reference.empty()) reference = read_mesh_with_warnings(o->reference, global);
+    if (!o->reference.empty()) {
+      report_progress("reading " + o->reference, part[2], part[3]);
+      reference = read_mesh_with_warnings(o->reference, global);
+    }
     const Mesh* reference_ptr = o->reference.empty() ? nullptr : &reference;
     CompareOptions options;
     options.sampling.samples = o->samples;
     options.sampling.seed = o->seed;
     MeshComparison c;
     try {
+      report_progress("comparing", part[3], part[4]);
       c = compare_meshes(result, input, reference_ptr, options);
     } catch (const CompareError& e) {
       const std::string& file = e.role() == MeshRole::Result  ? o->result
@@ -164,6 +175,7 @@ void register_compare_command(CLI::App& app, const GlobalOptions& global) {
                                                               : o->reference;
       throw std::runtime_error(file + ": " + e.what());
     }
+    progress.finish();
     if (o->json) {
       fmt::print("{}\n", comparison_json(c, *o, result, input, reference_ptr).dump(2));
     } else {

@@ -1,6 +1,7 @@
 // `vertexflow curvature IN OUT [--color ...] [--smooth N] [--json]`: principal curvatures and
 // directions per vertex, written as PLY properties (and optionally as colours).
 #include "cli_common.h"
+#include "progress.h"
 
 #include "vertexflow/colormap.h"
 #include "vertexflow/curvature.h"
@@ -47,7 +48,13 @@ void register_curvature_command(CLI::App& app, const GlobalOptions& global) {
   command->add_flag("--force", o->force, "Allow OUT to be the input file");
   command->callback([o, &global] {
     check_outputs({o->input}, {{o->output, /*mesh=*/true, /*may_replace_input=*/true}}, o->force);
+    // The progress line on a terminal (progress.h); curvature at 1M vertices is about as long as
+    // reading and writing the mesh together (docs/benchmarks.md).
+    ProgressLine progress(global);
+    const std::vector<double> part = progress_bounds({25, 50, 25});
+    report_progress("reading " + o->input, part[0], part[1]);
     Mesh mesh = read_mesh_with_warnings(o->input, global);
+    report_progress("curvature", part[1], part[2]);
     const Topology topology = build_topology(mesh.F, mesh.num_vertices());
     CurvatureOptions options;
     options.smoothing_rounds = o->smoothing_rounds;
@@ -79,7 +86,9 @@ void register_curvature_command(CLI::App& app, const GlobalOptions& global) {
     if (format_from_path(o->output) != MeshFormat::Ply && !global.quiet)
       fmt::print(stderr, "vertexflow: warning: {}: only PLY stores per-vertex properties; writing geometry{}\n",
                  o->output, mesh.vertex_colors().rows() ? " and colours" : "");
+    report_progress("writing " + o->output, part[2], part[3]);
     write_mesh(o->output, mesh);
+    progress.finish();
     if (o->json) {
       nlohmann::json out;
       out["input"] = o->input;

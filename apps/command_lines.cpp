@@ -2,6 +2,7 @@
 // `vertexflow compare-lines COARSE DENSE`: line-drawing fidelity against a dense mesh.
 #include "camera_options.h"
 #include "cli_common.h"
+#include "progress.h"
 
 #include "vertexflow/line_drawing.h"
 
@@ -103,7 +104,11 @@ void register_lines_command(CLI::App& app, const GlobalOptions& global) {
     options.render.color_bar = false;
     apply_camera_options(o->camera, options.render, global);
     apply_line_options(o->lines, options);
+    // The progress line on a terminal (progress.h), phases without a share.
+    ProgressLine progress(global);
+    progress.report_unknown("reading " + o->input);
     const Mesh mesh = read_mesh_with_warnings(o->input, global);
+    progress.report_unknown("drawing lines");
     LineDrawing drawing;
     Image underlay;
     try {
@@ -116,6 +121,7 @@ void register_lines_command(CLI::App& app, const GlobalOptions& global) {
       write_svg(o->output, drawing, o->line_width);
     else
       write_png(o->output, line_image(drawing, o->line_width, underlay));
+    progress.finish();
     if (o->json) {
       nlohmann::json counts;
       for (const LineType t : {LineType::Contour, LineType::SuggestiveContour, LineType::Ridge, LineType::Valley})
@@ -157,8 +163,13 @@ void register_compare_lines_command(CLI::App& app, const GlobalOptions& global) 
   command->callback([o, &global] {
     std::tie(o->fidelity.width, o->fidelity.height) = parse_image_size(o->size);
     apply_line_options(o->lines, o->fidelity.drawing);
+    // The progress line on a terminal (progress.h), phases without a share.
+    ProgressLine progress(global);
+    progress.report_unknown("reading " + o->coarse);
     const Mesh coarse = read_mesh_with_warnings(o->coarse, global);
+    progress.report_unknown("reading " + o->dense);
     const Mesh dense = read_mesh_with_warnings(o->dense, global);
+    progress.report_unknown(fmt::format("drawing and matching {} views", o->fidelity.views));
     // Both are drawn in the dense mesh's frame: a coarse mesh elsewhere draws nothing there, and
     // its F1 of 0 says where it is, not how its lines compare.
     const BoundingBox coarse_box = bounding_box(coarse.V), dense_box = bounding_box(dense.V);
@@ -175,6 +186,7 @@ void register_compare_lines_command(CLI::App& app, const GlobalOptions& global) 
     } catch (const std::invalid_argument& e) {
       throw std::runtime_error(o->coarse + " against " + o->dense + ": " + e.what());
     }
+    progress.finish();
     if (o->json) {
       nlohmann::json views = nlohmann::json::array();
       for (const LineFidelityView& v : fidelity.views)

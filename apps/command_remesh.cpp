@@ -1,6 +1,7 @@
 // `vertexflow remesh IN OUT (--target-vertices N | --edge-length L) [...]`: uniform isotropic
 // remeshing (CGAL), e.g. the paper's down-sampled input of Fig. 1(b).
 #include "cli_common.h"
+#include "progress.h"
 
 #include "vertexflow/quality.h"
 #include "vertexflow/remesh.h"
@@ -71,10 +72,15 @@ void register_remesh_command(CLI::App& app, const GlobalOptions& global) {
   command->add_flag("--force", o->force, "Allow OUT to be the input file");
   command->callback([o, &global] {
     check_outputs({o->input}, {{o->output, /*mesh=*/true, /*may_replace_input=*/true}}, o->force);
+    // The progress line on a terminal (progress.h); CGAL's runs are most of the time.
+    ProgressLine progress(global);
+    const std::vector<double> part = progress_bounds({3, 95, 2});
+    report_progress("reading " + o->input, part[0], part[1]);
     const Mesh mesh = read_mesh_with_warnings(o->input, global);
     warn_attributes_dropped(o->input, mesh, "remesh", global);
     RemeshResult result;
     try {
+      const ProgressPart remeshing("remeshing", part[1], part[2]);
       if (o->edge_length > 0) {
         result = remesh_to_edge_length(mesh.V, mesh.F, o->edge_length, o->remesh.isotropic);
       } else {
@@ -122,7 +128,9 @@ void register_remesh_command(CLI::App& app, const GlobalOptions& global) {
                  "vertexflow: warning: {}: the result had {} edges shorter than 1e-4 target edges (collapsed) and "
                  "zero-area faces ({} flipped, {} removed at the boundary)\n",
                  o->input, cleanup.collapsed_short_edges, cleanup.flipped_cap_edges, cleanup.removed_cap_faces);
+    report_progress("writing " + o->output, part[2], part[3]);
     write_mesh(o->output, result.mesh);
+    progress.finish();
     if (o->json) {
       nlohmann::json out;
       out["input"] = o->input;

@@ -1,6 +1,7 @@
 // `vertexflow report INPUT RESULT OUT.html [--json-report FILE]`: the HTML report of an enhance
 // result that already exists (for example from an earlier `vertexflow enhance`).
 #include "cli_common.h"
+#include "progress.h"
 
 #include "vertexflow/compare.h"
 #include "vertexflow/enhance.h"
@@ -42,7 +43,13 @@ void register_report_command(CLI::App& app, const GlobalOptions& global) {
   command->callback([o, &global] {
     // Reports never replace a mesh: there is no --force here.
     check_outputs({o->input, o->result}, {{o->html_file}, {o->json_file}}, /*force=*/false);
+    // The progress line on a terminal (progress.h): reading, the metrics (most of the time, as
+    // in enhance --report), the HTML (its share a guess).
+    ProgressLine progress(global);
+    const std::vector<double> part = progress_bounds({3.5, 3.5, 80, 13});
+    report_progress("reading " + o->input, part[0], part[1]);
     const Mesh input = read_mesh_with_warnings(o->input, global);
+    report_progress("reading " + o->result, part[1], part[2]);
     const Mesh result = read_mesh_with_warnings(o->result, global);
     // Edge flips give a result faces of its own, but never another vertex or face count.
     if (result.num_vertices() != input.num_vertices() || result.num_faces() != input.num_faces())
@@ -54,6 +61,7 @@ void register_report_command(CLI::App& app, const GlobalOptions& global) {
     nlohmann::json metrics;
     EnhanceCurvatures curvatures;
     try {
+      const ProgressPart measuring("metrics", part[2], part[3]);
       metrics = enhance_metrics(input, result, nullptr, &curvatures);
     } catch (const CompareError& e) {
       throw std::runtime_error((e.role() == MeshRole::Result ? o->result : o->input) + ": " + e.what());
@@ -65,6 +73,7 @@ void register_report_command(CLI::App& app, const GlobalOptions& global) {
     // File names need not be UTF-8: dump with U+FFFD for invalid bytes instead of failing.
     const auto replace = nlohmann::json::error_handler_t::replace;
     if (!o->json_file.empty()) write_text_file(o->json_file, metrics.dump(2, ' ', false, replace) + "\n");
+    report_progress("HTML report", part[3], part[4]);
     HtmlReportOptions options = html_report_options(o->input, o->result);
     options.max_display_faces = o->max_display_faces;
     write_html_report(o->html_file, input, result, curvatures.input, curvatures.result,

@@ -1,6 +1,7 @@
 // `vertexflow simplify IN OUT (--faces N | --ratio R) [--free-boundary] [--json]`: quadric-error
 // edge-collapse simplification (Garland and Heckbert 1997, through CGAL).
 #include "cli_common.h"
+#include "progress.h"
 
 #include "vertexflow/quality.h"
 #include "vertexflow/simplify.h"
@@ -38,11 +39,16 @@ void register_simplify_command(CLI::App& app, const GlobalOptions& global) {
   command->add_flag("--force", o->force, "Allow OUT to be the input file");
   command->callback([o, &global] {
     check_outputs({o->input}, {{o->output, /*mesh=*/true, /*may_replace_input=*/true}}, o->force);
+    // The progress line on a terminal (progress.h); CGAL's collapses are most of the time.
+    ProgressLine progress(global);
+    const std::vector<double> part = progress_bounds({5, 90, 5});
+    report_progress("reading " + o->input, part[0], part[1]);
     const Mesh mesh = read_mesh_with_warnings(o->input, global);
     warn_attributes_dropped(o->input, mesh, "simplify", global);
     o->simplify.keep_boundary = !o->free_boundary;
     SimplifyResult result;
     try {
+      report_progress("simplifying", part[1], part[2]);
       result = simplify(mesh.V, mesh.F, o->simplify);
     } catch (const std::invalid_argument& e) {
       throw std::runtime_error(o->input + ": " + e.what());
@@ -59,7 +65,9 @@ void register_simplify_command(CLI::App& app, const GlobalOptions& global) {
                    r.output_faces);
     }
     warn_about_repairs(o->input, r.repairs, global);
+    report_progress("writing " + o->output, part[2], part[3]);
     write_mesh(o->output, result.mesh);
+    progress.finish();
     if (o->json) {
       nlohmann::json out;
       out["input"] = o->input;

@@ -4,9 +4,12 @@
 
 #include "fit_rounds.h"
 #include "numerics/parallel.h"
+#include "vertexflow/progress.h"
 #include "vertexflow/quality.h"
 #include "vertexflow/timing.h"
 #include "vertexflow/topology.h"
+
+#include <fmt/format.h>
 
 #include <chrono>
 #include <cmath>
@@ -164,6 +167,9 @@ FitResult fit_to_smooth_surface(const Vertices& V, const Faces& F, const SmoothF
     result.V = V;
     return result;
   }
+  // Progress (progress.h): the patches, then at most max_rounds rounds (one by default).
+  constexpr double kPatchesEnd = 0.3;
+  report_progress("smooth patches", 0, kPatchesEnd);
   auto start = Clock::now();
   Topology topology = build_topology(F, V.rows());
   const std::vector<PnPatch> patches = pn_patches(V, F, topology, options.surface);
@@ -207,6 +213,9 @@ FitResult fit_to_smooth_surface(const Vertices& V, const Faces& F, const SmoothF
   double previous = mean_squared_distance(X);
   report.rms_distance.push_back(std::sqrt(previous));
   for (int round = 0; round < options.fit.max_rounds; ++round) {
+    const double width = (1 - kPatchesEnd) / options.fit.max_rounds;
+    report_progress(fmt::format("fit round {}", round + 1), kPatchesEnd + round * width,
+                    kPatchesEnd + (round + 1) * width);
     Vertices Y = rounds.step(X, rows, {}, report);
     const double energy = mean_squared_distance(Y);
     if (energy > previous) break;  // the guard held the round back so far it lost ground

@@ -11,6 +11,7 @@
 #include "vertexflow/curvature.h"
 #include "vertexflow/distance.h"
 #include "vertexflow/manifold_split.h"
+#include "vertexflow/progress.h"
 #include "vertexflow/timing.h"
 
 #include <fmt/format.h>
@@ -126,6 +127,13 @@ Eigen::VectorXd checked_density(const Curvature& c, const DensityRelaxation& opt
   return density;
 }
 
+// Progress (progress.h) in units of one round, from the phases' measured costs at 1M-10M
+// vertices (docs/benchmarks.md: "Peak RSS and wall time by phase", the size ladder, "Density
+// passes"): the set-up a tenth of a round, a density pass 0.15; within a round the curvature
+// 5%, the solve (assembly, preconditioner, iterations) 80%, the projection 8%, the guard 7%.
+constexpr double kSetUpUnits = 0.1, kDensityPassUnits = 0.15;
+constexpr double kSolveStarts = 0.05, kProjectionStarts = 0.85, kGuardStarts = 0.93;
+
 // The rounds of vertex_flow on a manifold, oriented mesh with valid options: on the input, or
 // with frames, curvature and projection from the reference S (vertex_flow_on_reference).
 FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options,
@@ -133,6 +141,16 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
   const Index n = static_cast<Index>(V.rows());
   FlowResult result;
   FlowReport& report = result.report;
+  const double units = kSetUpUnits + options.iterations + kDensityPassUnits * options.density.passes;
+  auto progress = [&](const std::string& phase, double from, double to) {
+    report_progress(phase, from / units, to / units);
+  };
+  // "solve" or, over several rounds, "solve (round 2/3)".
+  auto in_round = [&](const char* phase, int round) {
+    return options.iterations > 1 ? fmt::format("{} (round {}/{})", phase, round + 1, options.iterations)
+                                  : std::string(phase);
+  };
+  progress(reference ? "flow set-up, reference surface" : "flow set-up", 0, kSetUpUnits);
 
   const FlowSetup setup = prepare_flow(V, F, topology, options);
   std::optional<ReferenceSurface> surface;
@@ -173,6 +191,8 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
   Eigen::VectorXd density;
   for (int round = 0; round < options.iterations; ++round) {
     const Vertices start_of_round = X;
+    const double at = kSetUpUnits + round;
+    progress(in_round("curvature", round), at, at + kSolveStarts);
     // One solve: minimise the energy for positions X, frozen curvature of X.
     auto start = Clock::now();
     FlowFrame frame = surface ? flow_frame_on_reference(X, F, topology, options, setup.sliver_faces, *surface, fixed)
@@ -189,9 +209,11 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
       }
       break;
     }
+    progress(in_round("solve", round), at + kSolveStarts, at + kProjectionStarts);
     X = solver.solve(std::move(frame), options.weights, report);  // frees its curvature once assembled
     if (!X.allFinite()) throw std::runtime_error("vertex flow: the solver diverged");
     if (options.project_to_input) {
+      progress(in_round("projection", round), at + kProjectionStarts, at + kGuardStarts);
       start = Clock::now();
       project(X, free_rows);
       report.seconds_projection += seconds_since(start);
@@ -199,6 +221,7 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
     // Guarded after every round, not only the last: the next round's curvature is estimated on
     // X, and on the unguarded fandisk after three rounds (671 flipped or degenerate faces) it
     // reached 1e15 per mean edge length, which made the normal matrix numerically indefinite.
+    progress(in_round("guard", round), at + kGuardStarts, at + 1);
     start = Clock::now();
     const GuardCounts counts = guard(X, start_of_round, criteria, fixed, topology, options.guard, reproject, shortened);
     report.flipped_before_guard += counts.flipped_before_guard;
@@ -218,6 +241,8 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
     for (const Index i : free_rows)
       if (!topology.is_boundary_vertex[static_cast<std::size_t>(i)]) interior_rows.push_back(i);
     for (int pass = 0; pass < options.density.passes; ++pass) {
+      const double at = kSetUpUnits + options.iterations + kDensityPassUnits * pass;
+      progress(fmt::format("density pass {}/{}", pass + 1, options.density.passes), at, at + kDensityPassUnits);
       const Vertices start_of_pass = X;
       X = density_pass_proposal(X, F, topology, density, interior_rows, options.density.step);
       project(X, interior_rows);  // only the moved rows: the Phong lift is not idempotent
