@@ -2,6 +2,7 @@
 // writing, printing, and the JSON and HTML reports of what it did.
 #include "cli_common.h"
 #include "memory_estimate.h"
+#include "progress.h"
 
 #include "vertexflow/enhance.h"
 #include "vertexflow/html_report.h"
@@ -170,8 +171,17 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     callbacks.warning = [&](const std::string& what) {
       if (!global.quiet) fmt::print(stderr, "vertexflow: warning: {}: {}\n", o->input, what);
     };
+    // The progress line on a terminal (progress.h), and the command's parts by their measured
+    // costs (docs/benchmarks.md, size ladder, 1M-10M): reading 3.5% and writing 1.3% of a run
+    // without --report, the report's metrics 26-36% of one with it; a reference is read before
+    // the fit (6.5 s at 10M vertices) and the HTML report's share is a guess.
+    ProgressLine progress(global);
+    const bool measured = !o->report_file.empty() || !o->html_file.empty();
+    const std::vector<double> part = progress_bounds(
+        {3.5, on_reference ? 15.0 : 0.0, 100.0, 1.3, measured ? 45.0 : 0.0, o->html_file.empty() ? 0.0 : 5.0});
     auto start = Clock::now();
     phase("reading " + o->input);
+    report_progress("reading " + o->input, part[0], part[1]);
     // The face list as the file has it (enhance.h holds what the methods cannot work on).
     ReadOptions keep_faces;
     keep_faces.keep_face_list = true;
@@ -181,6 +191,7 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     std::optional<ReferenceSurface> reference;
     if (on_reference) {
       phase("reading " + o->reference_file);
+      report_progress("reading " + o->reference_file, part[1], part[2]);
       Mesh dense = read_mesh_with_warnings(o->reference_file, global);
       reference.emplace(std::move(dense.V), std::move(dense.F), o->reference_file);
     }
@@ -192,6 +203,7 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     const std::uint64_t trees_before = reference ? distance_trees_built(reference->faces().rows()) : 0;
     EnhanceResult result;
     try {
+      const ProgressPart engine("", part[2], part[3]);
       result = enhance(mesh, reference_pointer, options, callbacks);
     } catch (const std::invalid_argument& e) {
       throw std::runtime_error(o->input + ": " + e.what());
@@ -205,13 +217,17 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
                  o->output, result.provenance);
     start = Clock::now();
     phase("writing " + o->output);
+    report_progress("writing " + o->output, part[3], part[4]);
     write_mesh_with_warnings(o->output, out, global);
     const double seconds_write = seconds_since(start);
 
     if (o->report_file.empty() && o->html_file.empty()) return;
     // Each mesh's curvature, computed once for the metrics and the HTML report.
     EnhanceCurvatures curvatures;
-    nlohmann::json report = enhance_metrics(mesh, out, reference_pointer, &curvatures);
+    nlohmann::json report = [&] {
+      const ProgressPart metrics("metrics", part[4], part[5]);
+      return enhance_metrics(mesh, out, reference_pointer, &curvatures);
+    }();
     report.update(result.report);
     report["seconds"]["read"] = seconds_read;
     report["seconds"]["write"] = seconds_write;
@@ -229,6 +245,7 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
       phase("report written to " + o->report_file);
     }
     if (!o->html_file.empty()) {
+      report_progress("HTML report", part[5], part[6]);
       write_html_report(o->html_file, mesh, out, curvatures.input, curvatures.result, report.dump(),
                         html_report_options(o->input, o->output));
       phase("HTML report written to " + o->html_file);

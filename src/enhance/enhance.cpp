@@ -9,6 +9,7 @@
 #include "mesh/fan_walk.h"
 
 #include "vertexflow/enhance_options.h"
+#include "vertexflow/progress.h"
 #include "vertexflow/report_json.h"
 #include "vertexflow/timing.h"
 #include "vertexflow/topology.h"
@@ -260,6 +261,11 @@ nlohmann::json flip_and_refit(const Mesh& input, const ReferenceSurface* referen
   nlohmann::json cycles = nlohmann::json::array();
   Index total = 0;
   for (int cycle = 0; cycle < o.flip_cycles; ++cycle) {
+    // Progress (progress.h): each cycle a part, its flips and its refit half each.
+    const int cycles_run = fit ? o.flip_cycles : 1;
+    const ProgressPart cycle_part("", static_cast<double>(cycle) / cycles_run,
+                                  static_cast<double>(cycle + 1) / cycles_run);
+    report_progress("edge flips", 0, fit ? 0.5 : 1);
     EdgeFlipResult flipped = flip_edges_toward(out.V, out.F, to_target, flips, &slot_normals);
     const EdgeFlipReport& r = flipped.report;
     nlohmann::json entry = {
@@ -268,6 +274,7 @@ nlohmann::json flip_and_refit(const Mesh& input, const ReferenceSurface* referen
     if (r.flips > 0) {
       out.F = std::move(flipped.F);
       if (fit) {
+        const ProgressPart refit_part("refit", 0.5, 1);
         out.V = fit_to_reference(out.V, out.F, *reference, refit).V;
         entry["refitted"] = true;
       }
@@ -409,6 +416,23 @@ void validate_enhance_options(const EnhanceOptions& options, bool has_reference,
 
 namespace {
 
+// How progress (progress.h) names a mode's method until the method names its own phases.
+const char* progress_phase(EnhanceMode mode) {
+  switch (mode) {
+    case EnhanceMode::Flow:
+      return "flow";
+    case EnhanceMode::ReferenceFit:
+      return "fit to reference";
+    case EnhanceMode::ReferenceFlow:
+      return "flow on reference";
+    case EnhanceMode::Smooth:
+      return "fit to smooth surface";
+    case EnhanceMode::Unsharp:
+      return "unsharp mask";
+  }
+  return "enhance";
+}
+
 // The engine on a mesh whose faces all have three distinct vertices, positive area and no
 // duplicate, and whose vertices all have faces; attributes are left to enhance(). `topology`, when
 // given, is the mesh's (build_topology), for the flow.
@@ -453,6 +477,9 @@ EnhanceResult enhance_clean(const Mesh& mesh, const ReferenceSurface* reference,
   const std::string* fitted_by = find_fit_provenance(mesh.comments);
   const SmoothFitOptions smooth = effective_smooth_options(options, fitted_by != nullptr);
   MethodRun run;
+  // Progress (progress.h): the method, then the flips (their cost guessed equal: no figures).
+  std::optional<ProgressPart> method_part;
+  method_part.emplace(progress_phase(mode), 0, options.edge_flips ? 0.5 : 1);
   switch (mode) {
     case EnhanceMode::ReferenceFit:
       run = run_fit(mesh, *reference, effective_fit_options(options), callbacks);
@@ -475,9 +502,12 @@ EnhanceResult enhance_clean(const Mesh& mesh, const ReferenceSurface* reference,
   Mesh& out = result.mesh;
   out.V = std::move(run.V);
   out.F = mesh.F;
-  if (options.edge_flips)
+  method_part.reset();
+  if (options.edge_flips) {
+    const ProgressPart flips_part("edge flips", 0.5, 1);
     run.report["edge_flips"] =
         flip_and_refit(mesh, mode == EnhanceMode::ReferenceFit ? reference : nullptr, options, out, callbacks);
+  }
 
   // The input's provenance and a line for this run, so a chain of runs stays visible and a
   // later smooth-mode run can tell a fitted input (provenance.h).
@@ -592,6 +622,11 @@ EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const
                       const EnhanceCallbacks& callbacks) {
   validate_enhance_options(options, reference != nullptr, mesh.num_vertices());
   if (reference) check_reference_fits(mesh, *reference);
+  // Progress (progress.h): this preparation took 0.2-2.6 s of 16-200 s runs at 1M-10M
+  // (docs/benchmarks.md); re-sampling attributes is a guess (no figures at that size).
+  constexpr double kPrepared = 0.02, kMethodEnds = 0.95;
+  const double method_ends = mesh.attributes.empty() ? 1 : kMethodEnds;
+  report_progress("preparing", 0, kPrepared);
   try {
     mesh.attributes.validate(mesh.num_vertices(), mesh.num_faces());
   } catch (const std::invalid_argument& e) {
@@ -638,6 +673,7 @@ EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const
   if (whole && mesh.attributes.empty()) {
     // The flow takes the topology; the other modes build what they need, so it goes now.
     if (enhance_mode(options, reference != nullptr) != EnhanceMode::Flow) topology.reset();
+    const ProgressPart part("", kPrepared, method_ends);
     return enhance_clean(mesh, reference, options, callbacks, topology ? &*topology : nullptr);
   }
 
@@ -684,7 +720,10 @@ EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const
                                       cut.edges.size(), cut.vertices_welded));
 
   // The topology built for the seams is the flow's too when the methods work on the input.
-  EnhanceResult result = enhance_clean(methods_mesh, reference, o, callbacks, whole ? &*topology : nullptr);
+  EnhanceResult result = [&] {
+    const ProgressPart part("", kPrepared, method_ends);
+    return enhance_clean(methods_mesh, reference, o, callbacks, whole ? &*topology : nullptr);
+  }();
   Mesh out;
   if (whole) {
     out.V = std::move(result.mesh.V);
@@ -730,6 +769,7 @@ EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const
   if (!cut.empty())
     result.report["cut_seams"] = {{"edges", cut.edges.size()}, {"vertices_welded", cut.vertices_welded}};
   if (!mesh.attributes.empty()) {
+    report_progress("attributes", kMethodEnds, 1);
     const auto start = Clock::now();
     attributes_detail::TransportReport t;
     out.attributes = attributes_detail::transport_attributes(mesh, faces, *topology, charts, out.V, out.F, t);
