@@ -45,6 +45,10 @@ int main(int argc, char** argv) {
         options.sliver_hole_share = std::stod(value);
       else if (arg == "--subdivisions")
         options.subdivisions = std::stoi(value);
+      else if (arg == "--hole-radius-min")
+        options.hole_radius_min = std::stod(value);
+      else if (arg == "--hole-radius-max")
+        options.hole_radius_max = std::stod(value);
       else if (arg == "--seed")
         options.seed = static_cast<unsigned>(std::stoul(value));
       else

@@ -59,8 +59,8 @@ struct IsotropicRemeshOptions {
   double small_piece_edges = 2.0;
   SmallPieces small_pieces = SmallPieces::remove;
   /// A boundary loop shorter than this many target edge lengths is kept (>= 0; 0 resamples
-  /// every loop): instead of collapsing it to a triangle of short edges, about one vertex per
-  /// half target edge (at least 3) stays at its input position.
+  /// every loop): instead of being collapsed to a triangle of short edges or pinched against
+  /// a neighbour, about one vertex per target edge (at least 3) stays at its input position.
   double short_loop_edges = 3.0;
 };
 
