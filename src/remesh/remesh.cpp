@@ -3,6 +3,7 @@
 #include "vertexflow/remesh.h"
 
 #include "surface_mesh_conversion.h"
+#include "vertexflow/progress.h"
 #include "vertexflow/timing.h"
 #include "vertexflow/topology.h"
 
@@ -379,6 +380,9 @@ RemeshResult remesh_to_vertex_count(const Vertices& V, const Faces& F, const Rem
   double length = kLengthFactor * edge_length_for_vertex_count(area, options.target_vertices);
   for (int attempt = 0; attempt < options.max_attempts; ++attempt) {
     check_vertex_estimate(area, length);
+    // Progress (progress.h): each run a part of max_attempts (the search usually ends sooner).
+    report_progress(fmt::format("remesh run {}", attempt + 1), static_cast<double>(attempt) / options.max_attempts,
+                    static_cast<double>(attempt + 1) / options.max_attempts);
     const auto attempt_start = std::chrono::steady_clock::now();
     SurfaceRepairs repairs{input_split, 0, 0};
     RemeshCleanup cleanup;
