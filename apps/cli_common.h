@@ -120,5 +120,6 @@ void register_compare_lines_command(CLI::App& app, const GlobalOptions& global);
 void register_report_command(CLI::App& app, const GlobalOptions& global);
 void register_compare_command(CLI::App& app, const GlobalOptions& global);
 void register_batch_command(CLI::App& app, const GlobalOptions& global);
+void register_lod_command(CLI::App& app, const GlobalOptions& global);
 
 }  // namespace vertexflow::cli

@@ -39,6 +39,7 @@ int main(int argc, char** argv) {
   register_report_command(app, global);
   register_compare_command(app, global);
   register_batch_command(app, global);
+  register_lod_command(app, global);
   require_finite_numbers(app);
   plain_option_messages(app);
   try {

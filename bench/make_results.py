@@ -618,8 +618,9 @@ def main():
     results["commands"] = r.commands
     (out / "results.json").write_text(json.dumps(results, indent=1) + "\n")
     # The hand-made sections (their commands are in them) follow as they are, so that a
-    # regeneration keeps them: docs/results_checker.md, spot under render --texture checker.
-    kept = [Path(__file__).resolve().parent.parent / "docs" / "results_checker.md"]
+    # regeneration keeps them: docs/results_checker.md, spot under render --texture checker;
+    # docs/results_lod.md, the LoD table of build/bin/lod_peers (bench/lod_peers.cpp, issue 30).
+    kept = [Path(__file__).resolve().parent.parent / "docs" / name for name in ("results_checker.md", "results_lod.md")]
     tail = ["\n" + path.read_text() for path in kept if path.exists()]
     (out / "results.md").write_text("\n".join(header + md) + "\n" + "".join(tail))
     print(f"wrote {out / 'results.md'} and {out / 'results.json'} ({len(r.commands)} commands)")

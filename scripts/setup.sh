@@ -24,6 +24,7 @@ packages=(
   libcairo2-dev            # anti-aliased strokes of line drawings (`vertexflow lines`)
   libgtest-dev libgmock-dev
   libbenchmark-dev
+  libmeshoptimizer-dev     # meshoptimizer, the LoD peer of bench/lod_peers.cpp
   clang libclang-rt-14-dev # libFuzzer targets and sanitizers
   clang-format
   python3                  # bench/make_results.py (docs/results.md)

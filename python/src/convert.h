@@ -131,5 +131,6 @@ void register_metrics(py::module_& m);
 void register_remesh(py::module_& m);
 void register_render_lines(py::module_& m);
 void register_batch(py::module_& m);
+void register_lod(py::module_& m);
 
 }  // namespace vertexflow::python

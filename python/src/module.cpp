@@ -21,4 +21,5 @@ printed: pass progress=callable to hear about progress.)doc";
   vertexflow::python::register_remesh(m);
   vertexflow::python::register_render_lines(m);
   vertexflow::python::register_batch(m);
+  vertexflow::python::register_lod(m);
 }
