@@ -209,10 +209,15 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
       }
       break;
     }
-    progress(in_round("solve", round), at + kSolveStarts, at + kProjectionStarts);
     // X equals start_of_round and frame.P here: freed for the solve, whose peak is the run's.
     Vertices().swap(X);
-    X = solver.solve(std::move(frame), options.weights, report);  // frees its curvature once assembled
+    {
+      // The solver reports its iterations within this part (flow_solver.h).
+      const std::string phase = in_round("solve", round);
+      const ProgressPart part(phase, (at + kSolveStarts) / units, (at + kProjectionStarts) / units);
+      solver.set_progress_phase(phase);
+      X = solver.solve(std::move(frame), options.weights, report);  // frees its curvature once assembled
+    }
     if (!X.allFinite()) throw std::runtime_error("vertex flow: the solver diverged");
     if (options.project_to_input) {
       progress(in_round("projection", round), at + kProjectionStarts, at + kGuardStarts);

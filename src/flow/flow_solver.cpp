@@ -44,6 +44,7 @@
 #include "numerics/sparse_cholesky.h"
 #include "numerics/vertex_ordering.h"
 
+#include "vertexflow/progress.h"
 #include "vertexflow/timing.h"
 
 #include <algorithm>
@@ -85,6 +86,36 @@ constexpr double kSwitchAbovePredicted = 105;
 constexpr int kIterationCapFactor = 10;
 // The fallback is taken only when the predicted factor (9 x the vertex graph's fill) fits.
 constexpr double kMaxFactorBytes = 2.0 * 1024 * 1024 * 1024;
+
+// The iterations run in chunks of this many between progress reports: at 1M vertices about
+// half a second, a few dozen reports per solve. Resuming is exact (conjugate_gradients.h keeps
+// its state), so the iterates are those of one uninterrupted run.
+constexpr int kIterationsPerReport = 10;
+// The solve's part before the iterations (assembly, preconditioner): a tenth, for the progress.
+constexpr double kSetUpShare = 0.1;
+
+// At most max_iterations of cg, reporting `phase` between chunks at the fraction of the way from
+// |r| = |b| to |r| = tolerance |b| on a log scale (progress.h), never below `done` (the most
+// reported so far: the residual of conjugate gradients is not monotone). Returns what one
+// cg.run would.
+IterationResult run_reporting(ConjugateGradients& cg, int max_iterations, double tolerance, const std::string& phase,
+                              double& done) {
+  IterationResult total;
+  do {  // at least once: a run of 0 iterations still says whether the iterate has converged
+    const int chunk = std::clamp(max_iterations - total.iterations, 0, kIterationsPerReport);
+    const IterationResult part = cg.run(chunk, tolerance);
+    total.iterations += part.iterations;
+    const double residual = cg.relative_residual();
+    done = std::max(done, residual > 0 ? std::clamp(std::log(residual) / std::log(tolerance), 0.0, 1.0) : 1.0);
+    report_progress(phase, kSetUpShare + (1 - kSetUpShare) * done, 1);
+    if (part.converged) {
+      total.converged = true;
+      break;
+    }
+    if (part.iterations < chunk) break;  // stopped at a non-positive curvature, as one run would
+  } while (total.iterations < max_iterations);
+  return total;
+}
 
 // The size of the largest connected region of free vertices with |k1| + |k2| < kFlatCurvature.
 Index largest_flat_region(const FlowTerms& t) {
@@ -147,6 +178,7 @@ struct FlowSystemSolver::Impl {
   std::optional<NormalMatrixPattern> pattern;
   std::optional<SparseCholesky::Ordering> ordering;  // of the free vertex graph
   SparseCholesky cholesky;
+  std::string progress_phase = "solve";
 
   Impl(const Topology& t, std::vector<char> f, LinearSolver k, double tol)
       : topology(t), fixed(std::move(f)), kind(k), tolerance(tol) {}
@@ -219,6 +251,10 @@ FlowSystemSolver::FlowSystemSolver(const Topology& topology, std::vector<char> f
 
 FlowSystemSolver::~FlowSystemSolver() = default;
 
+void FlowSystemSolver::set_progress_phase(std::string phase) {
+  impl_->progress_phase = std::move(phase);
+}
+
 Vertices FlowSystemSolver::solve(const FlowFrame& frame, const EnergyWeights& weights, FlowReport& report) {
   return solve(frame, nullptr, weights, report);
 }
@@ -257,9 +293,10 @@ Vertices FlowSystemSolver::solve(const FlowFrame& frame, FlowFrame* release, con
     start = Clock::now();
     const int budget = static_cast<int>(std::ceil(kBudgetPerSqrtVertex * std::sqrt(static_cast<double>(m))));
     IterationResult result;
+    double done = 0;  // of the iterations, for the progress
     if (s.kind == LinearSolver::Automatic && !multilevel) {
       // Block-Jacobi first; if the first iterations predict a long run, switch.
-      result = cg.run(std::min(kProbeIterations, budget), s.tolerance);
+      result = run_reporting(cg, std::min(kProbeIterations, budget), s.tolerance, s.progress_phase, done);
       if (!result.converged && cg.predicted_iterations(s.tolerance) > kSwitchAbovePredicted) {
         report.seconds_solve += seconds_since(start);
         start = Clock::now();
@@ -270,9 +307,9 @@ Vertices FlowSystemSolver::solve(const FlowFrame& frame, FlowFrame* release, con
       }
     }
     if (!result.converged)
-      result =
-          cg.run((s.kind == LinearSolver::Automatic ? budget : kIterationCapFactor * budget) - cg.total_iterations(),
-                 s.tolerance);
+      result = run_reporting(
+          cg, (s.kind == LinearSolver::Automatic ? budget : kIterationCapFactor * budget) - cg.total_iterations(),
+          s.tolerance, s.progress_phase, done);
     if (!result.converged && s.kind == LinearSolver::Automatic) {
       // Fall back to the factorisation if it fits; otherwise keep iterating.
       report.seconds_solve += seconds_since(start);
@@ -283,7 +320,7 @@ Vertices FlowSystemSolver::solve(const FlowFrame& frame, FlowFrame* release, con
       if (9.0 * factor_entries * sizeof(double) <= kMaxFactorBytes) {
         direct = true;
       } else {
-        result = cg.run((kIterationCapFactor - 1) * budget, s.tolerance);
+        result = run_reporting(cg, (kIterationCapFactor - 1) * budget, s.tolerance, s.progress_phase, done);
       }
     }
     report.seconds_solve += seconds_since(start);

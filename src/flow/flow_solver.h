@@ -8,6 +8,7 @@
 #include "vertexflow/flow_energy.h"
 
 #include <memory>
+#include <string>
 #include <vector>
 
 namespace vertexflow {
@@ -32,6 +33,11 @@ class FlowSystemSolver {
   /// The same, releasing the frame's curvature and sliver blocks once the system is assembled
   /// (168 bytes per vertex that the solve, the flow's longest phase, does not need).
   Vertices solve(FlowFrame&& frame, const EnergyWeights& weights, FlowReport& report);
+
+  /// The phase name under which the iterations report their progress (progress.h): the fall of
+  /// the relative residual towards the tolerance, on a log scale, every few iterations. The
+  /// caller places the solve's part (ProgressPart); the default is "solve".
+  void set_progress_phase(std::string phase);
 
  private:
   Vertices solve(const FlowFrame& frame, FlowFrame* release, const EnergyWeights& weights, FlowReport& report);

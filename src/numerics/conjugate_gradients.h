@@ -67,6 +67,8 @@ class ConjugateGradients {
 
   [[nodiscard]] const BlockVector& solution() const { return d_; }
   [[nodiscard]] int total_iterations() const { return total_iterations_; }
+  /// |r| / |b| of the current iterate (0 for b = 0).
+  [[nodiscard]] double relative_residual() const { return b_norm_ > 0 ? r_norm_ / b_norm_ : 0.0; }
 
  private:
   double precondition();  // z = B r (+ C r); returns r . z

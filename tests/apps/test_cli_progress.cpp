@@ -297,7 +297,12 @@ TEST(Progress, EnhanceReportsItsPhasesInOrderAndChangesNothing) {
   EXPECT_EQ(reported.mesh.V, quiet.mesh.V);
   const std::vector<std::string> expected{"preparing", "flow",       "flow set-up", "curvature",
                                           "solve",     "projection", "guard"};
-  EXPECT_EQ(phases, expected);
+  // The solve reports every few iterations (flow_solver.cpp): bunny_uniform's 80 iterations
+  // give 9 reports of "solve", the part's own and one per 10 iterations.
+  std::vector<std::string> distinct = phases;
+  distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+  EXPECT_EQ(distinct, expected);
+  EXPECT_GE(std::count(phases.begin(), phases.end(), "solve"), 5);
   for (std::size_t i = 0; i < phases.size(); ++i) {
     EXPECT_GE(begins[i], 0);
     EXPECT_LE(begins[i], ends[i]);
