@@ -65,8 +65,12 @@ struct EnhanceOptions {
   /// ReferenceFit, Smooth: rounds of solve and guard at most; none keeps each mode's default
   /// (FitOptions::max_rounds 10, SmoothFitOptions's 1).
   std::optional<int> max_rounds;
-  /// Smooth: fit even an input that looks decimated or whose provenance records a fit
-  /// (SmoothFitOptions::max_poor_face_fraction 1, already_fitted false).
+  /// Flow (with or without density passes), Smooth: the caller asserts that the input's vertices
+  /// lie on the true surface, so the method runs even on an input that looks decimated or like a
+  /// subdivision control mesh (input_check.h) or, in smooth mode, whose provenance records a fit
+  /// (SmoothFitOptions::max_poor_face_fraction and max_sharp_edge_fraction 1, already_fitted
+  /// false). Without it such inputs are held: returned unchanged, with a warning and the report's
+  /// "hold" section.
   bool assume_on_surface = false;
 
   /// Flow, ReferenceFlow: the flow's own options (weights, curvature, solver, projection,
@@ -174,6 +178,12 @@ void check_reference_fits(const Mesh& mesh, const ReferenceSurface& reference);
 ///
 /// A reference must be the input's surface in the input's units (check_reference_fits): a
 /// std::invalid_argument, one line naming the reference, refuses one that does not.
+///
+/// Flow and Smooth first check the input (input_check.h): one that looks decimated or like a
+/// subdivision control mesh (and, in smooth mode, one whose provenance records a fit) is held,
+/// its vertices returned unchanged, with one warning that names the reason and suggests a
+/// reference, unless assume_on_surface. The report's "hold" section records the decision
+/// (held, reason, poor_face_fraction, sharp_edge_fraction, thresholds, assume_on_surface).
 ///
 /// The face list comes back as it went in. Faces the methods cannot work on (a repeated vertex,
 /// zero area by mesh.h's bound, a repeat of an earlier face) stay in it, and their vertices are

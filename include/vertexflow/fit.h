@@ -35,6 +35,7 @@
 #pragma once
 
 #include "vertexflow/guard.h"
+#include "vertexflow/input_check.h"
 #include "vertexflow/mesh.h"
 #include "vertexflow/reference_surface.h"
 
@@ -91,6 +92,11 @@ struct FitReport {
   /// as decimated for exceeding SmoothFitOptions::max_poor_face_fraction (returned unchanged).
   double poor_face_fraction = 0;
   bool held_as_decimated = false;
+  /// Smooth mode: the share of the input's interior edges sharper than kSharpEdgeAngle
+  /// (input_check.h), and whether it was held as a subdivision control mesh for exceeding
+  /// SmoothFitOptions::max_sharp_edge_fraction (returned unchanged; decimation is tested first).
+  double sharp_edge_fraction = 0;
+  bool held_as_control_mesh = false;
   /// Smooth mode: the input was held as already fitted (SmoothFitOptions::already_fitted).
   bool held_as_fitted = false;
 };
@@ -139,9 +145,13 @@ Mesh smooth_surface_estimate(const Vertices& V, const Faces& F, const SmoothSurf
 /// remeshing and scanning do not: thin triangles. Inputs with more than
 /// max_poor_face_fraction of their faces below quality 0.3 (triangle_quality, quality.h) are
 /// therefore held as decimated: returned unchanged, with FitReport::held_as_decimated set.
-/// Measured fractions: 5.6-10.7% on those four QEM outputs, 0% on the remeshes, at most 1.9%
-/// on the data meshes that are not decimated (fertility); camelhead (7.6%) and max-planck-5k
-/// (8.8%) are decimated scans. A previous run of smooth mode keeps the input's triangle
+/// Measured fractions: 2.95-20.5% on QEM outputs of 9 data meshes at 10% and 25% of their faces,
+/// 0% on the remeshes, at most 1.9% on the data meshes that are not decimated (fertility);
+/// camelhead (7.6%) and max-planck-5k (8.8%) are decimated scans. The control mesh of a
+/// subdivision surface has its vertices off the limit surface too, outside it where the patches
+/// bulge out: inputs with more than max_sharp_edge_fraction of their interior edges sharper than
+/// 40 degrees are held as control meshes (FitReport::held_as_control_mesh; input_check.h gives the
+/// measured shares). A previous run of smooth mode keeps the input's triangle
 /// shapes, so its mark is in the file instead: the provenance line each run of `enhance` writes
 /// (provenance.h). An input whose comments record a smooth-mode or reference-mode fit is held
 /// as already fitted (already_fitted; on bunny_adaptive the first run lowers the mean distance
@@ -150,7 +160,10 @@ struct SmoothFitOptions {
   SmoothSurfaceOptions surface;
   /// Inputs with a larger fraction of faces below quality 0.3 are held as decimated (above);
   /// 1 fits every input.
-  double max_poor_face_fraction = 0.03;
+  double max_poor_face_fraction = kMaxPoorFaceFraction;
+  /// Inputs with a larger share of interior edges sharper than kSharpEdgeAngle are held as
+  /// subdivision control meshes (above); 1 fits every input.
+  double max_sharp_edge_fraction = kMaxSharpEdgeFraction;
   /// The caller knows the vertices were placed off the surface by an earlier fit (the input's
   /// provenance, find_fit_provenance in provenance.h): the input is returned unchanged, with
   /// FitReport::held_as_fitted set, before the quality test.
@@ -170,7 +183,8 @@ struct SmoothFitOptions {
 };
 
 /// Smooth mode (above). Throws std::invalid_argument as fit_to_reference, as
-/// smooth_surface_estimate, and for max_poor_face_fraction outside [0, 1].
+/// smooth_surface_estimate, and for max_poor_face_fraction or max_sharp_edge_fraction outside
+/// [0, 1].
 FitResult fit_to_smooth_surface(const Vertices& V, const Faces& F, const SmoothFitOptions& options = {});
 
 /// Checks the options' ranges: samples_per_vertex > 0, weights >= 0 and finite (proximity > 0),

@@ -13,6 +13,7 @@
 //   vertexflow enhance --reference NAME --reference-method flow   the flow on the reference
 //   vertexflow enhance --surface smooth [--assume-on-surface] [--edge-flips]
 //   vertexflow enhance --surface smooth (held: REASON)            smooth mode held the input
+//   vertexflow enhance --surface input (held: REASON)             the flow held it (input_check.h)
 //   vertexflow enhance --method unsharp
 // NAME is the reference's file name without its directories, with blanks and control
 // characters replaced by '?', so that the line stays one line of space-separated words ('?' for
@@ -41,8 +42,9 @@ struct ProvenanceRun {
   std::string reference;
   bool edge_flips = false;
   bool assume_on_surface = false;
-  /// Smooth mode held the input unchanged; the reason, e.g. "already fitted" (non-empty means
-  /// held, and the line then records no fit).
+  /// Smooth mode or the flow held the input unchanged; the reason, e.g. "already fitted" or
+  /// "decimated" (hold_reason_name, input_check.h; non-empty means held, and the line then
+  /// records no fit).
   std::string held;
 };
 

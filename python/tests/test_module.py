@@ -24,7 +24,7 @@ def read(name):
 @pytest.mark.parametrize("name, cli_args, kwargs", [
     ("bunny_uniform.off", [], {}),
     ("fandisk.off", [], {}),
-    ("max-planck-5k.obj", [], {}),
+    ("max-planck-5k.obj", ["--assume-on-surface"], {"assume_on_surface": True}),  # decimated: held without
     ("spot.obj", ["--solver", "direct", "--lambda", "0.5"], {"solver": "direct", "lam": 0.5}),
     ("bunny_uniform.off", ["--density-passes", "5"], {"density_passes": 5}),
 ])
@@ -85,8 +85,14 @@ def test_smooth_mode_holds_decimated_input_unless_told():
     assert report["fit"]["held_as_decimated"] and np.array_equal(held, Vq)
     fitted, report = vertexflow.enhance(Vq, Fq, surface="smooth", assume_on_surface=True)
     assert not report["fit"]["held_as_decimated"] and not np.array_equal(fitted, Vq)
+    # The paper's flow holds it too (input_check.h), and the same keyword flows it anyway.
+    flowed, report = vertexflow.enhance(Vq, Fq)
+    assert report["hold"]["held"] and report["hold"]["reason"] == "decimated" and np.array_equal(flowed, Vq)
+    assert any("decimated" in w for w in report["warnings"])
+    flowed, report = vertexflow.enhance(Vq, Fq, assume_on_surface=True)
+    assert not report["hold"]["held"] and not np.array_equal(flowed, Vq)
     with pytest.raises(ValueError, match="assume_on_surface"):
-        vertexflow.enhance(Vq, Fq, assume_on_surface=True)
+        vertexflow.enhance(Vq, Fq, method="unsharp", assume_on_surface=True)
 
 
 def test_comments_round_trip_and_smooth_mode_holds_what_its_provenance_says_is_fitted(tmp_path):

@@ -9,6 +9,7 @@
 #include "mesh/fan_walk.h"
 
 #include "vertexflow/enhance_options.h"
+#include "vertexflow/input_check.h"
 #include "vertexflow/progress.h"
 #include "vertexflow/report_json.h"
 #include "vertexflow/timing.h"
@@ -92,6 +93,8 @@ void require_shared_untouched(const EnhanceOptions& o) {
   require_default(o.fit.max_rounds, fit.max_rounds, "fit.max_rounds", "max_rounds");
   require_default(o.smooth.fit.max_rounds, smooth.fit.max_rounds, "smooth.fit.max_rounds", "max_rounds");
   require_default(o.smooth.max_poor_face_fraction, smooth.max_poor_face_fraction, "smooth.max_poor_face_fraction",
+                  "assume_on_surface");
+  require_default(o.smooth.max_sharp_edge_fraction, smooth.max_sharp_edge_fraction, "smooth.max_sharp_edge_fraction",
                   "assume_on_surface");
   require_default(o.smooth.already_fitted, smooth.already_fitted, "smooth.already_fitted",
                   "assume_on_surface (the engine reads the input's provenance)");
@@ -184,22 +187,80 @@ MethodRun run_fit(const Mesh& mesh, const ReferenceSurface& reference, const Fit
   return run;
 }
 
+// The input check of issue 30 (input_check.h) for the methods that assume the vertices on the
+// true surface: the check's verdict (with the default thresholds, also under assume_on_surface,
+// so the report says what the flag overrode), whether the input is held, and the warning.
+struct Hold {
+  HoldReason reason = HoldReason::None;
+  bool held = false;
+  double poor_face_fraction = 0, sharp_edge_fraction = 0;
+};
+
+Hold decide_hold(double poor_face_fraction, double sharp_edge_fraction, bool already_fitted, bool assume_on_surface) {
+  Hold hold;
+  hold.poor_face_fraction = poor_face_fraction;
+  hold.sharp_edge_fraction = sharp_edge_fraction;
+  hold.reason = already_fitted                                ? HoldReason::AlreadyFitted
+                : poor_face_fraction > kMaxPoorFaceFraction   ? HoldReason::Decimated
+                : sharp_edge_fraction > kMaxSharpEdgeFraction ? HoldReason::ControlMesh
+                                                              : HoldReason::None;
+  hold.held = hold.reason != HoldReason::None && !assume_on_surface;
+  return hold;
+}
+
+// The one warning line of a held input: the measured reason, what was held, and the two ways on.
+void warn_about_hold(const Hold& hold, EnhanceMode mode, const std::string* fitted_by, const Warnings& warn) {
+  std::string why;
+  switch (hold.reason) {
+    case HoldReason::AlreadyFitted:
+      why = fmt::format(
+          "its provenance comment '{}' records an earlier fit, which left the vertices off the surface "
+          "the faces inscribe",
+          fitted_by ? *fitted_by : std::string());
+      break;
+    case HoldReason::Decimated:
+      why = fmt::format(
+          "{:.1f}% of the faces are below quality 0.3 (over {:g}%): a decimated mesh, whose vertices lie "
+          "off the surface",
+          100 * hold.poor_face_fraction, 100 * kMaxPoorFaceFraction);
+      break;
+    case HoldReason::ControlMesh:
+      why = fmt::format(
+          "{:.1f}% of the edges turn by more than {:g} degrees (over {:g}%): a subdivision control mesh, "
+          "whose vertices lie off its limit surface",
+          100 * hold.sharp_edge_fraction, kSharpEdgeAngle, 100 * kMaxSharpEdgeFraction);
+      break;
+    case HoldReason::None:
+      return;
+  }
+  const bool smooth = mode == EnhanceMode::Smooth;
+  warn(
+      fmt::format("{}: {}, which assumes them on it, held every vertex; --reference DENSE fits it to a dense mesh "
+                  "of the surface, --assume-on-surface {} anyway",
+                  why, smooth ? "smooth mode" : "the paper's flow", smooth ? "fits" : "flows"));
+}
+
+// The report's "hold" section.
+nlohmann::json hold_json(const Hold& hold, bool assume_on_surface) {
+  return {
+      {"held", hold.held},
+      {"reason", hold.reason == HoldReason::None ? nlohmann::json() : nlohmann::json(hold_reason_name(hold.reason))},
+      {"poor_face_fraction", hold.poor_face_fraction},
+      {"sharp_edge_fraction", hold.sharp_edge_fraction},
+      {"thresholds",
+       {{"poor_face_fraction", kMaxPoorFaceFraction},
+        {"sharp_edge_fraction", kMaxSharpEdgeFraction},
+        {"sharp_edge_angle", kSharpEdgeAngle}}},
+      {"assume_on_surface", assume_on_surface}};
+}
+
 MethodRun run_smooth(const Mesh& mesh, const SmoothFitOptions& options, const std::string* fitted_by,
-                     const EnhanceCallbacks& callbacks, const Warnings& warn) {
+                     bool assume_on_surface, const EnhanceCallbacks& callbacks, const Warnings& warn) {
   FitResult result = fit_to_smooth_surface(mesh.V, mesh.F, options);
   const FitReport& r = result.report;
-  if (r.held_as_fitted)
-    warn(
-        fmt::format("its provenance comment '{}' records an earlier fit, which left the vertices off the surface "
-                    "the faces inscribe: smooth mode, which assumes them on it, held every vertex (provenance.h; "
-                    "--assume-on-surface fits anyway)",
-                    fitted_by ? *fitted_by : std::string()));
-  else if (r.held_as_decimated)
-    warn(
-        fmt::format("{:.1f}% of the faces are below quality 0.3, as on decimated meshes, whose vertices lie off "
-                    "the surface: smooth mode, which assumes them on it, held every vertex (fit.h; "
-                    "--assume-on-surface fits anyway)",
-                    100 * r.poor_face_fraction));
+  const Hold hold = decide_hold(r.poor_face_fraction, r.sharp_edge_fraction, fitted_by != nullptr, assume_on_surface);
+  if (hold.held)
+    warn_about_hold(hold, EnhanceMode::Smooth, fitted_by, warn);
   else
     tell(callbacks.phase,
          fmt::format("patches {:.3f} s; fitted in {} round{}: RMS distance to them {:.6g} -> {:.6g}; {} vertices "
@@ -210,6 +271,8 @@ MethodRun run_smooth(const Mesh& mesh, const SmoothFitOptions& options, const st
   run.report = r;
   run.report["fit"]["poor_face_fraction"] = r.poor_face_fraction;
   run.report["fit"]["held_as_decimated"] = r.held_as_decimated;
+  run.report["fit"]["sharp_edge_fraction"] = r.sharp_edge_fraction;
+  run.report["fit"]["held_as_control_mesh"] = r.held_as_control_mesh;
   run.report["fit"]["held_as_fitted"] = r.held_as_fitted;
   run.report["fit"]["fitted_by"] = r.held_as_fitted && fitted_by ? nlohmann::json(*fitted_by) : nlohmann::json();
   run.report["options"] = options.fit;
@@ -217,6 +280,8 @@ MethodRun run_smooth(const Mesh& mesh, const SmoothFitOptions& options, const st
     run.report["options"].erase(unused);
   run.report["options"]["surface"] = options.surface;
   run.report["options"]["max_poor_face_fraction"] = options.max_poor_face_fraction;
+  run.report["options"]["max_sharp_edge_fraction"] = options.max_sharp_edge_fraction;
+  run.report["hold"] = hold_json(hold, assume_on_surface);
   run.V = std::move(result.V);
   return run;
 }
@@ -368,7 +433,7 @@ SmoothFitOptions effective_smooth_options(const EnhanceOptions& o, bool already_
   smooth.fit.constraints = o.constraints;
   smooth.fit.guard = o.guard;
   if (o.max_rounds) smooth.fit.max_rounds = *o.max_rounds;
-  if (o.assume_on_surface) smooth.max_poor_face_fraction = 1.0;
+  if (o.assume_on_surface) smooth.max_poor_face_fraction = smooth.max_sharp_edge_fraction = 1.0;
   smooth.already_fitted = already_fitted && !o.assume_on_surface;
   return smooth;
 }
@@ -485,7 +550,7 @@ EnhanceResult enhance_clean(const Mesh& mesh, const ReferenceSurface* reference,
       run = run_fit(mesh, *reference, effective_fit_options(options), callbacks);
       break;
     case EnhanceMode::Smooth:
-      run = run_smooth(mesh, smooth, fitted_by, callbacks, warn);
+      run = run_smooth(mesh, smooth, fitted_by, options.assume_on_surface, callbacks, warn);
       break;
     case EnhanceMode::Unsharp:
       run = run_unsharp(mesh, effective_unsharp_options(options), warn);
@@ -493,17 +558,33 @@ EnhanceResult enhance_clean(const Mesh& mesh, const ReferenceSurface* reference,
     case EnhanceMode::ReferenceFlow:
       run = run_flow(mesh, reference, flow, callbacks, warn, nullptr);
       break;
-    case EnhanceMode::Flow:
-      run = run_flow(mesh, nullptr, flow, callbacks, warn, topology);
+    case EnhanceMode::Flow: {
+      // The flow and its density passes slide the vertices over the input's facets: an input
+      // whose vertices look off the true surface is held (input_check.h).
+      const InputCheck check = check_input(mesh.V, mesh.F);
+      const Hold hold =
+          decide_hold(check.poor_face_fraction, check.sharp_edge_fraction, false, options.assume_on_surface);
+      if (hold.held) {
+        warn_about_hold(hold, EnhanceMode::Flow, nullptr, warn);
+        run.report = FlowReport{};
+        run.report["options"] = flow;
+        run.V = mesh.V;
+      } else {
+        run = run_flow(mesh, nullptr, flow, callbacks, warn, topology);
+      }
+      run.report["hold"] = hold_json(hold, options.assume_on_surface);
       break;
+    }
   }
+  // A held input comes back unchanged: no edge flips either.
+  const bool held = run.report.contains("hold") && run.report["hold"]["held"].get<bool>();
 
   // Same connectivity (unless edge flips); enhance() carries the attributes.
   Mesh& out = result.mesh;
   out.V = std::move(run.V);
   out.F = mesh.F;
   method_part.reset();
-  if (options.edge_flips) {
+  if (options.edge_flips && !held) {
     const ProgressPart flips_part("edge flips", 0.5, 1);
     run.report["edge_flips"] =
         flip_and_refit(mesh, mode == EnhanceMode::ReferenceFit ? reference : nullptr, options, out, callbacks);
@@ -516,9 +597,7 @@ EnhanceResult enhance_clean(const Mesh& mesh, const ReferenceSurface* reference,
   if (reference) provenance.reference = reference->name();
   provenance.edge_flips = options.edge_flips;
   provenance.assume_on_surface = options.assume_on_surface;
-  if (mode == EnhanceMode::Smooth && run.report["fit"]["held_as_fitted"].get<bool>())
-    provenance.held = "already fitted";
-  if (mode == EnhanceMode::Smooth && run.report["fit"]["held_as_decimated"].get<bool>()) provenance.held = "decimated";
+  if (held) provenance.held = run.report["hold"]["reason"].get<std::string>();
   result.provenance = provenance_line(provenance);
   out.comments = mesh.comments;
   append_provenance(out.comments, result.provenance);

@@ -263,9 +263,11 @@ std::vector<EnhanceOptionSpec> make_specs() {
                          [](auto& o) -> auto& { return o.max_rounds; }),
                      1, 100));
   t.push_back(member_spec(
-      "assume_on_surface", "assume_on_surface", "--assume-on-surface", K::Bool, kSmooth,
-      "Smooth mode: fit even inputs that look decimated (over 3% of the faces below quality "
-      "0.3) or whose provenance records a fit, whose vertices usually lie off the surface (fit.h)",
+      "assume_on_surface", "assume_on_surface", "--assume-on-surface", K::Bool, kFlow | kSmooth,
+      "The paper's flow (density passes too) and smooth mode: the vertices lie on the true surface; "
+      "run even on inputs that look decimated (over 2.5% of the faces below quality 0.3) or like a "
+      "subdivision control mesh (over 8% of the edges sharper than 40 degrees), or, in smooth mode, "
+      "whose provenance records a fit, which are otherwise held unchanged (input_check.h)",
       [](auto& o) -> auto& { return o.assume_on_surface; }));
 
   // The fit's and smooth mode's own (fit.h).

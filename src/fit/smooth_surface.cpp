@@ -157,13 +157,18 @@ FitResult fit_to_smooth_surface(const Vertices& V, const Faces& F, const SmoothF
   validate_fit(V, F, options.fit, "smooth fit");
   if (!(options.max_poor_face_fraction >= 0 && options.max_poor_face_fraction <= 1))
     throw std::invalid_argument("smooth fit: max_poor_face_fraction must be in [0, 1]");
+  if (!(options.max_sharp_edge_fraction >= 0 && options.max_sharp_edge_fraction <= 1))
+    throw std::invalid_argument("smooth fit: max_sharp_edge_fraction must be in [0, 1]");
   FitResult result;
   FitReport& report = result.report;
-  report.poor_face_fraction = summarize_quality(triangle_quality(V, F)).fraction_below_0_3;
-  if (options.already_fitted || report.poor_face_fraction > options.max_poor_face_fraction) {
-    // One reason: the provenance, when there is one, says more than the triangle shapes.
+  const InputCheck check = check_input(V, F, {options.max_poor_face_fraction, options.max_sharp_edge_fraction});
+  report.poor_face_fraction = check.poor_face_fraction;
+  report.sharp_edge_fraction = check.sharp_edge_fraction;
+  if (options.already_fitted || check.reason != HoldReason::None) {
+    // One reason: the provenance, when there is one, says more than the mesh's shape.
     report.held_as_fitted = options.already_fitted;
-    report.held_as_decimated = !options.already_fitted;
+    report.held_as_decimated = !options.already_fitted && check.reason == HoldReason::Decimated;
+    report.held_as_control_mesh = !options.already_fitted && check.reason == HoldReason::ControlMesh;
     result.V = V;
     return result;
   }

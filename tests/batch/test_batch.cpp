@@ -225,7 +225,9 @@ TEST(Batch, ADamagedSummaryIsNamedAndItsRowsMeasuredAgain) {
     ASSERT_EQ(row["status"], "done") << row.dump();
     ASSERT_TRUE(row["redistribution_rho"]["result"].is_number()) << row.dump();
   }
-  EXPECT_GT(first[0]["displacement_edge_lengths"]["max"].get<double>(), 0.0);
+  // The sphere moved (the 56-vertex rounded cube, 22% of its edges sharper than 40 degrees, is
+  // held as a control mesh: input_check.h).
+  EXPECT_GT(first[1]["displacement_edge_lengths"]["max"].get<double>(), 0.0);
 
   ASSERT_EQ(test::run_cli("--quiet " + command).exit_code, 0);
   const nlohmann::json kept = summary_rows(out);

@@ -1,0 +1,90 @@
+// The input check of input_check.h: the share of poor faces and of sharp interior edges.
+#include "vertexflow/input_check.h"
+
+#include "vertexflow/quality.h"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <vector>
+
+namespace vertexflow {
+namespace {
+
+struct EdgeSide {
+  Index a, b;  // the edge's vertices, a < b
+  Index face;
+  bool operator<(const EdgeSide& o) const { return a != o.a ? a < o.a : b != o.b ? b < o.b : face < o.face; }
+};
+
+}  // namespace
+
+const char* hold_reason_name(HoldReason reason) {
+  switch (reason) {
+    case HoldReason::None:
+      return "none";
+    case HoldReason::Decimated:
+      return "decimated";
+    case HoldReason::ControlMesh:
+      return "subdivision control mesh";
+    case HoldReason::AlreadyFitted:
+      return "already fitted";
+  }
+  return "?";
+}
+
+InputCheck check_input(const Vertices& V, const Faces& F, const InputCheckOptions& options) {
+  for (const double t : {options.max_poor_face_fraction, options.max_sharp_edge_fraction})
+    if (!(t >= 0 && t <= 1)) throw std::invalid_argument("input check: thresholds must be in [0, 1]");
+  InputCheck check;
+  check.poor_face_fraction = summarize_quality(triangle_quality(V, F)).fraction_below_0_3;
+
+  // Unit normals; faces without area get none, and their edges are left out.
+  const Index m = F.rows();
+  std::vector<Eigen::Vector3d> normal(static_cast<std::size_t>(m));
+  std::vector<char> has_normal(static_cast<std::size_t>(m), 0);
+  for (Index f = 0; f < m; ++f) {
+    const Eigen::Vector3d p = V.row(F(f, 0)).transpose(), q = V.row(F(f, 1)).transpose(),
+                          r = V.row(F(f, 2)).transpose();
+    const Eigen::Vector3d n = (q - p).cross(r - p);
+    const double length = n.norm();
+    if (length > 0 && std::isfinite(length) && F(f, 0) != F(f, 1) && F(f, 1) != F(f, 2) && F(f, 2) != F(f, 0)) {
+      normal[static_cast<std::size_t>(f)] = n / length;
+      has_normal[static_cast<std::size_t>(f)] = 1;
+    }
+  }
+  // Each edge's sides, sorted so an edge's faces are adjacent (deterministic, no hashing).
+  std::vector<EdgeSide> sides;
+  sides.reserve(static_cast<std::size_t>(3 * m));
+  for (Index f = 0; f < m; ++f)
+    if (has_normal[static_cast<std::size_t>(f)])
+      for (int k = 0; k < 3; ++k) {
+        const Index u = F(f, k), w = F(f, (k + 1) % 3);
+        sides.push_back({std::min(u, w), std::max(u, w), f});
+      }
+  std::sort(sides.begin(), sides.end());
+  const double cos_sharp = std::cos(kSharpEdgeAngle * std::numbers::pi / 180);
+  Index sharp = 0;
+  for (std::size_t i = 0; i < sides.size();) {
+    std::size_t j = i + 1;
+    while (j < sides.size() && sides[j].a == sides[i].a && sides[j].b == sides[i].b) ++j;
+    if (j - i == 2) {
+      ++check.interior_edges;
+      const double c =
+          normal[static_cast<std::size_t>(sides[i].face)].dot(normal[static_cast<std::size_t>(sides[i + 1].face)]);
+      if (c < cos_sharp) ++sharp;
+    }
+    i = j;
+  }
+  if (check.interior_edges > 0)
+    check.sharp_edge_fraction = static_cast<double>(sharp) / static_cast<double>(check.interior_edges);
+
+  if (check.poor_face_fraction > options.max_poor_face_fraction)
+    check.reason = HoldReason::Decimated;
+  else if (check.sharp_edge_fraction > options.max_sharp_edge_fraction)
+    check.reason = HoldReason::ControlMesh;
+  return check;
+}
+
+}  // namespace vertexflow
