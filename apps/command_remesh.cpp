@@ -68,6 +68,11 @@ void register_remesh_command(CLI::App& app, const GlobalOptions& global) {
                    "loop)")
       ->check(CLI::Range(0.0, 1000.0))
       ->capture_default_str();
+  command
+      ->add_option("--fill-holes-below", o->remesh.isotropic.fill_hole_edges,
+                   "Fill boundary loops shorter than this many target edges before remeshing (0: fill none)")
+      ->check(CLI::Range(0.0, 1000.0))
+      ->capture_default_str();
   command->add_flag("--json", o->json, "Print a summary as JSON on stdout");
   command->add_flag("--force", o->force, "Allow OUT to be the input file");
   command->callback([o, &global] {
@@ -123,6 +128,9 @@ void register_remesh_command(CLI::App& app, const GlobalOptions& global) {
       fmt::print(stderr,
                  "vertexflow: {}: {} boundary loops shorter than {:g} target edges kept ({} of their vertices held)\n",
                  o->input, cleanup.short_loops, o->remesh.isotropic.short_loop_edges, cleanup.held_loop_vertices);
+    if (!global.quiet && cleanup.filled_holes > 0)
+      fmt::print(stderr, "vertexflow: {}: {} holes shorter than {:g} target edges filled\n", o->input,
+                 cleanup.filled_holes, o->remesh.isotropic.fill_hole_edges);
     if (!global.quiet && cleanup.collapsed_short_edges + cleanup.flipped_cap_edges + cleanup.removed_cap_faces > 0)
       fmt::print(stderr,
                  "vertexflow: warning: {}: the result had {} edges shorter than 1e-4 target edges (collapsed) and "
@@ -162,11 +170,13 @@ void register_remesh_command(CLI::App& app, const GlobalOptions& global) {
       out["min_edge_length"] = r.quality.min_edge_length;
       out["small_piece_edges"] = o->remesh.isotropic.small_piece_edges;
       out["short_loop_edges"] = o->remesh.isotropic.short_loop_edges;
+      out["fill_hole_edges"] = o->remesh.isotropic.fill_hole_edges;
       out["cleanup"] = {{"small_pieces", cleanup.small_pieces},
                         {"small_piece_faces", cleanup.small_piece_faces},
                         {"small_pieces_kept", cleanup.small_pieces_kept},
                         {"short_loops_kept", cleanup.short_loops},
                         {"held_loop_vertices", cleanup.held_loop_vertices},
+                        {"filled_holes", cleanup.filled_holes},
                         {"collapsed_short_edges", cleanup.collapsed_short_edges},
                         {"flipped_cap_edges", cleanup.flipped_cap_edges},
                         {"removed_cap_faces", cleanup.removed_cap_faces}};

@@ -62,6 +62,11 @@ struct IsotropicRemeshOptions {
   /// every loop): instead of being collapsed to a triangle of short edges or pinched against
   /// a neighbour, about one vertex per target edge (at least 3) stays at its input position.
   double short_loop_edges = 3.0;
+  /// A boundary loop shorter than this many target edge lengths is filled before remeshing
+  /// (>= 0; 0, the default, fills none). Holes far below an edge keep needles at their rims
+  /// whatever is held (docs/remesh.md); filled, they are remeshed over, and the vertices that
+  /// land in them lie on the fill (the loop's triangulation), not on the input surface.
+  double fill_hole_edges = 0.0;
 };
 
 /// What remeshing a raw scan took beyond CGAL's run (all 0 on a clean input).
@@ -71,11 +76,13 @@ struct RemeshCleanup {
   bool small_pieces_kept = false;   ///< copied unchanged (SmallPieces::keep) rather than removed
   Index short_loops = 0;            ///< input boundary loops shorter than short_loop_edges, kept
   Index held_loop_vertices = 0;     ///< their vertices held at input positions
+  Index filled_holes = 0;           ///< input boundary loops shorter than fill_hole_edges, filled
   Index collapsed_short_edges = 0;  ///< result edges below 1e-4 target lengths, collapsed
   Index flipped_cap_edges = 0;      ///< longest edges of zero-area faces, flipped
   Index removed_cap_faces = 0;      ///< zero-area faces on the boundary, removed
   [[nodiscard]] bool any() const {
-    return small_pieces + short_loops + collapsed_short_edges + flipped_cap_edges + removed_cap_faces > 0;
+    return small_pieces + short_loops + filled_holes + collapsed_short_edges + flipped_cap_edges + removed_cap_faces >
+           0;
   }
 };
 

@@ -8,6 +8,7 @@
 #include "vertexflow/topology.h"
 
 #include <CGAL/Polygon_mesh_processing/remesh.h>
+#include <CGAL/Polygon_mesh_processing/triangulate_hole.h>
 #include <CGAL/boost/graph/Euler_operations.h>
 #include <fmt/format.h>
 
@@ -39,6 +40,8 @@ void check_options(const IsotropicRemeshOptions& options) {
     throw std::invalid_argument("remesh: small_piece_edges must be a finite number >= 0");
   if (!(options.short_loop_edges >= 0) || !std::isfinite(options.short_loop_edges))
     throw std::invalid_argument("remesh: short_loop_edges must be a finite number >= 0");
+  if (!(options.fill_hole_edges >= 0) || !std::isfinite(options.fill_hole_edges))
+    throw std::invalid_argument("remesh: fill_hole_edges must be a finite number >= 0");
 }
 
 // Edges shorter than this many target lengths are collapsed after CGAL's run (issue 31: a raw
@@ -180,6 +183,28 @@ void hold_short_loops(const SurfaceMesh& mesh, double edge_length, const Isotrop
   }
 }
 
+// Fills the boundary loops shorter than options.fill_hole_edges target lengths with CGAL's
+// hole triangulation (no new vertex), so that CGAL remeshes over them.
+void fill_small_holes(SurfaceMesh& mesh, double edge_length, const IsotropicRemeshOptions& options,
+                      RemeshCleanup& cleanup) {
+  if (options.fill_hole_edges == 0) return;
+  std::vector<char> visited(mesh.num_halfedges(), 0);
+  std::vector<HalfedgeIndex> holes;
+  for (const HalfedgeIndex start : mesh.halfedges()) {
+    if (!mesh.is_border(start) || visited[start.idx()]) continue;
+    double perimeter = 0;
+    HalfedgeIndex h = start;
+    do {
+      visited[h.idx()] = 1;
+      perimeter += length(mesh, h);
+      h = mesh.next(h);
+    } while (h != start);
+    if (perimeter < options.fill_hole_edges * edge_length) holes.push_back(start);
+  }
+  for (const HalfedgeIndex h : holes) PMP::triangulate_hole(mesh, h, CGAL::Emptyset_iterator());
+  cleanup.filled_holes = static_cast<Index>(holes.size());
+}
+
 // Whether collapsing e keeps the mesh manifold: CGAL's link condition, and not an interior
 // edge between two boundary vertices (that would pinch).
 bool can_collapse(const SurfaceMesh& mesh, EdgeIndex e) {
@@ -250,6 +275,7 @@ Mesh run(SurfaceMesh mesh, double edge_length, const IsotropicRemeshOptions& opt
          RemeshCleanup& cleanup) {
   cleanup = {};
   const Mesh kept = take_small_pieces(mesh, edge_length, options, cleanup);
+  fill_small_holes(mesh, edge_length, options, cleanup);
   auto held = mesh.add_property_map<VertexIndex, bool>("v:vertexflow_held", false).first;
   hold_short_loops(mesh, edge_length, options, held, cleanup);
   const auto parameters = CGAL::parameters::number_of_iterations(static_cast<unsigned>(options.iterations))

@@ -422,6 +422,38 @@ TEST(RemeshRawScan, ShortLoopsAreKept) {
             << " vertices, perimeter " << loop_length(without.mesh, collapsed.boundary_loops.front()) << "\n";
 }
 
+// fill_hole_edges fills the loops shorter than that many target edges before remeshing: the
+// sphere's small hole is closed over, a long loop is kept; off by default.
+TEST(RemeshRawScan, HolesBelowTheFillLengthAreFilled) {
+  const Mesh sphere = test::icosphere(1.0, 5);
+  // Two holes: the faces within 0.06 of the north pole (perimeter 0.45), within 0.3 of the
+  // south pole (perimeter about 1.9).
+  std::vector<Index> kept_faces;
+  for (Index f = 0; f < sphere.num_faces(); ++f) {
+    bool near = false;
+    for (int k = 0; k < 3; ++k) {
+      near = near || (sphere.V.row(sphere.F(f, k)) - Eigen::RowVector3d(0, 0, 1)).norm() < 0.06;
+      near = near || (sphere.V.row(sphere.F(f, k)) - Eigen::RowVector3d(0, 0, -1)).norm() < 0.3;
+    }
+    if (!near) kept_faces.push_back(f);
+  }
+  Mesh holed;
+  holed.V = sphere.V;
+  holed.F.resize(static_cast<Index>(kept_faces.size()), 3);
+  for (std::size_t i = 0; i < kept_faces.size(); ++i) holed.F.row(static_cast<Index>(i)) = sphere.F.row(kept_faces[i]);
+  ASSERT_EQ(build_topology(holed.F, holed.num_vertices()).boundary_loops.size(), 2u);
+  const double L = 0.2;
+  IsotropicRemeshOptions options;
+  options.fill_hole_edges = 5;  // loops under 1.0: the north hole (0.45) only
+  const RemeshResult filled = remesh_to_edge_length(holed.V, holed.F, L, options);
+  EXPECT_EQ(filled.report.cleanup.filled_holes, 1);
+  EXPECT_EQ(filled.report.quality.boundary_loops, 1);
+  test::expect_clean_surface(filled.mesh);
+  const RemeshResult kept = remesh_to_edge_length(holed.V, holed.F, L);
+  EXPECT_EQ(kept.report.cleanup.filled_holes, 0);
+  EXPECT_EQ(kept.report.quality.boundary_loops, 2);
+}
+
 // An edge shorter than 1e-4 target edges left in the result (here a protected boundary edge of
 // 1e-6 of its input length) is collapsed; without that the result would keep it.
 TEST(RemeshRawScan, EdgesFarBelowTheTargetAreCollapsed) {
