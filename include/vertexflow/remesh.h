@@ -26,9 +26,10 @@
 //   loops or leave a zero-area face).
 // - Raw scans (issue 31; docs/remesh.md): connected pieces too small to remesh (bounding box
 //   diagonal below small_piece_edges target edges) are removed, or with
-//   SmallPieces::keep copied to the output as they are; boundary loops shorter than
-//   short_loop_edges target edges are kept: never collapsed, some of their vertices held at
-//   their input positions. Neither changes a mesh without such pieces or loops.
+//   SmallPieces::keep copied to the output as they are (outside the short-edge bound above);
+//   boundary loops shorter than short_loop_edges target edges are kept: never collapsed, some
+//   of their vertices held at their input positions; with fill_hole_edges, loops shorter than
+//   that are filled instead. None of this changes a mesh without such pieces or loops.
 #pragma once
 
 #include "vertexflow/manifold_split.h"
@@ -42,7 +43,7 @@ namespace vertexflow {
 /// What happens to connected pieces of the input too small to remesh.
 enum class SmallPieces {
   remove,  ///< left out of the output
-  keep,    ///< copied to the output unchanged (their faces are not remeshed)
+  keep,    ///< copied to the output unchanged: not remeshed, their edges and quality the input's
 };
 
 /// One CGAL isotropic_remeshing run.
