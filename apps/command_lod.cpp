@@ -170,7 +170,8 @@ void register_lod_command(CLI::App& app, const GlobalOptions& global) {
   command->add_option("--format", o->format, "Format of the level meshes (default: DENSE's)")
       ->check(CLI::IsMember({"ply", "obj", "off", "stl", "gltf", "glb"}));
   command->add_option("--samples", o->samples, "Area-uniform samples per distance measurement")
-      ->check(CLI::Range(Index{0}, Index{100000000}));
+      ->check(CLI::Range(Index{0}, Index{100000000}))
+      ->capture_default_str();
   command->add_flag("--html", o->html, "Also write STEM_lod.html: the levels side by side (PNGs beside it)");
   command->add_flag("--force", o->force, "Recompute levels an earlier run in OUT_DIR finished");
   command->callback([o, &global] {
@@ -275,14 +276,15 @@ void register_lod_command(CLI::App& app, const GlobalOptions& global) {
         throw std::runtime_error(o->input + ": " + e.what());
       }
       const LodLevelReport& r = level.report;
+      warn_about_repairs(o->input, r.simplify.repairs, global);  // as `simplify` says them
       say(
           fmt::format("level {}: {} faces, mean distance {:.4g} (QEM alone {:.4g}, {:+.1f}%), Hausdorff {:.4g} (QEM "
                       "{:.4g}), min quality {:.3f}, {:.2f} s",
                       i + 1, r.faces, r.fitted.mean, r.qem.mean, 100 * (r.fitted.mean / r.qem.mean - 1),
                       r.fitted.hausdorff, r.qem.hausdorff, r.min_quality, r.seconds));
       if (r.fit_skipped)
-        say(fmt::format("level {}: QEM alone lies on {} up to rounding (Hausdorff {:.3g}): not fitted", i + 1, o->input,
-                        r.qem.hausdorff));
+        say(fmt::format("level {}: QEM alone lies on {} up to rounding (RMS distance {:.3g}): not fitted", i + 1,
+                        o->input, r.qem.rms));
       else if (r.kept_qem && !global.quiet)
         fmt::print(stderr,
                    "vertexflow: warning: {}: level {}: the fit measured a larger mean distance than QEM alone; the "

@@ -19,10 +19,10 @@
 // than its QEM alone (keep_better_of_two), the level is QEM alone, and the level's report says
 // so (LodLevelReport::kept_qem). The fit minimises a squared-distance energy with a guard, so it
 // may lose on the mean at a level where it gains on the RMS. A level that QEM alone puts on D up
-// to rounding (Hausdorff distance at most kLodExactRelative of D's bounding-box diagonal: a
-// decimation of a flat subdivision, or of D's planar parts) is not fitted at all: the fit could
-// only add rounding (on such a 1M-vertex armadillo it measured 1.3-1.5 times QEM's 3e-13 mean
-// distance, after 2-27 rounds and 100-240 s a level).
+// to rounding (RMS distance at most kLodExactRelative of D's bounding-box diagonal: a decimation
+// of a flat subdivision, or of D's planar parts) is not fitted at all: the fit could only add
+// rounding (on such a 1M-vertex armadillo it measured 1.3-1.5 times QEM's 3e-13 mean distance,
+// after 2-27 rounds and 100-240 s a level).
 //
 // Input: as simplify.h takes it (a non-manifold or inconsistently oriented D is simplified
 // through its manifold split; boundary loops kept exactly unless keep_boundary is false, and the
@@ -44,7 +44,7 @@
 
 namespace vertexflow {
 
-/// Relative Hausdorff distance of QEM alone to D at and below which a level is not fitted (above).
+/// Relative RMS distance of QEM alone to D at and below which a level is not fitted (above).
 inline constexpr double kLodExactRelative = 1e-9;
 
 struct LodOptions {

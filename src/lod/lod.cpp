@@ -103,7 +103,7 @@ LodLevel lod_level(const Mesh& previous, const ReferenceSurface& dense, Index ta
   report_progress("measure", 0.35, 0.42);
   r.qem = lod_distance(qem.mesh, dense, options.sampling);
   r.measure_seconds = seconds_since(t);
-  if (r.qem.hausdorff <= kLodExactRelative * bounding_box(dense.vertices()).diagonal()) {
+  if (r.qem.rms <= kLodExactRelative * bounding_box(dense.vertices()).diagonal()) {
     r.fit_skipped = true;
     r.kept_qem = true;
     r.fitted = r.qem;
