@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include <fstream>
+#include <iostream>
 #include <sstream>
 
 namespace vertexflow {
@@ -164,8 +165,20 @@ TEST(CliRemesh, RawScanIsRemeshedCleanAndEnhancedInEveryMode) {
     ASSERT_EQ(e.exit_code, 0) << mode << ": " << e.err;
     const auto rep = nlohmann::json::parse(test::read_text(report));
     EXPECT_EQ(rep["flipped_faces"], 0) << mode;
+    // The input check (flow, density passes, smooth mode) does not take the remesh for decimated.
+    if (rep.contains("hold")) {
+      EXPECT_EQ(rep["hold"]["held"], false) << mode;
+    }
     if (mode == "--surface smooth") {
-      EXPECT_EQ(rep["fit"]["held_as_decimated"], false);
+      // Smooth mode brings it closer to the dense mesh: measured -11.9% (issue 31 asks for 5%).
+      const auto c = run_cli("compare --json " + shell_quote(dir.file("enhanced.ply").string()) + " " +
+                             shell_quote(out.string()) + " --reference " + quoted_data_path("bunny.off"));
+      ASSERT_EQ(c.exit_code, 0) << c.err;
+      const auto d = nlohmann::json::parse(c.out)["distance"];
+      const double before = d["input_reference"]["input_to_reference"]["mean_relative"];
+      const double after = d["result_reference"]["result_to_reference"]["mean_relative"];
+      std::cout << "[measured] smooth mode on the raw-scan remesh: mean distance " << before << " -> " << after << "\n";
+      EXPECT_LT(after, 0.95 * before);
     }
   }
 
