@@ -127,7 +127,8 @@ TEST(CliReport, EnhanceReportHoldsTheFlowsOptionsAndReport) {
   for (const char* key : {"solver", "solver_tolerance", "max_halvings", "curvature"})
     EXPECT_TRUE(report["options"].contains(key)) << key;
   EXPECT_EQ(keys(report), with_metrics({"input", "output", "method", "options", "solver", "guard", "non_manifold",
-                                        "seconds", "provenance", "peak_memory_bytes"}));
+                                        "seconds", "provenance", "peak_memory_bytes", "hold"}));
+  EXPECT_FALSE(report["hold"]["held"]);  // fandisk is neither decimated nor a control mesh (input_check.h)
   EXPECT_EQ(report["provenance"], "vertexflow enhance --surface input");  // the line added to OUT (provenance.h)
   EXPECT_EQ(keys(report["seconds"]), (std::set<std::string>{"read", "curvature", "assembly", "solve", "factorization",
                                                             "projection", "guard", "density", "write"}));
