@@ -1,6 +1,7 @@
 // Levels of detail fitted to their dense mesh (lod.h): budgets, monotone face counts, no flipped
 // face, boundaries kept, the fit closer to the dense mesh than QEM alone, the better of the two
 // kept, and the same bytes for any thread count.
+#include "boundary_points.h"
 #include "shapes.h"
 #include "test_support.h"
 
@@ -18,16 +19,8 @@
 namespace vertexflow {
 namespace {
 
-using Point = std::array<double, 3>;
-
-std::set<Point> boundary_points(const Mesh& mesh) {
-  const Topology topology = build_topology(mesh.F, mesh.num_vertices());
-  std::set<Point> points;
-  for (Index v = 0; v < mesh.num_vertices(); ++v)
-    if (topology.is_boundary_vertex[static_cast<std::size_t>(v)])
-      points.insert({mesh.V(v, 0), mesh.V(v, 1), mesh.V(v, 2)});
-  return points;
-}
+using test::boundary_points;
+using test::Point;
 
 // Fewer area samples than the default: the figures the tests compare move by well under their
 // tolerances (measured below), and the tests run in a few seconds.

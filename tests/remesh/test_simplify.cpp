@@ -1,5 +1,6 @@
 // Garland-Heckbert simplification: the face budget, topology, exact boundaries, geometric error
 // on a sphere and on planes, refusal of meshes a halfedge structure cannot hold.
+#include "boundary_points.h"
 #include "shapes.h"
 #include "test_support.h"
 
@@ -18,16 +19,8 @@
 namespace vertexflow {
 namespace {
 
-using Point = std::array<double, 3>;
-
-std::set<Point> boundary_points(const Mesh& mesh) {
-  const Topology topology = build_topology(mesh.F, mesh.num_vertices());
-  std::set<Point> points;
-  for (Index v = 0; v < mesh.num_vertices(); ++v)
-    if (topology.is_boundary_vertex[static_cast<std::size_t>(v)])
-      points.insert({mesh.V(v, 0), mesh.V(v, 1), mesh.V(v, 2)});
-  return points;
-}
+using test::boundary_points;
+using test::Point;
 
 TEST(Simplify, HitsTheFaceBudgetWithinOneFace) {
   const Mesh spot = read_mesh(test::data_path("spot.obj"));
