@@ -192,7 +192,18 @@ void register_lod_command(CLI::App& app, const GlobalOptions& global) {
     if (!is_mesh_path("x" + ext)) throw IoError(o->input + ": no mesh format for the levels; give --format");
     if (std::filesystem::exists(dir) && !std::filesystem::is_directory(dir))
       throw IoError(o->output_dir + ": is not a directory");
+    const bool dir_existed = std::filesystem::exists(dir);
     std::filesystem::create_directories(dir);
+    // A directory this run made goes again if the run fails before writing into it (a bad or
+    // unreadable DENSE): nothing is left behind. One with levels in it stays, to be resumed.
+    struct RemoveIfEmpty {
+      std::filesystem::path dir;
+      bool armed;
+      ~RemoveIfEmpty() {
+        std::error_code error;
+        if (armed && std::filesystem::is_empty(dir, error) && !error) std::filesystem::remove(dir, error);
+      }
+    } const made_here{dir, !dir_existed};
     const std::filesystem::path json_path = dir / (stem + "_lod.json"), md_path = dir / (stem + "_lod.md"),
                                 html_path = dir / (stem + "_lod.html");
     check_outputs({o->input}, {{json_path}, {md_path}, {o->html ? html_path : std::filesystem::path()}}, false);

@@ -80,3 +80,14 @@ def test_bad_levels_are_refused_in_one_line(tmp_path):
     result = run_lod(DATA / "spot.obj", tmp_path, "--faces", "6000")
     assert result.returncode == 1 and "not in [1, 5856)" in result.stderr
     assert not list(tmp_path.glob("*.obj"))
+
+
+def test_a_bad_dense_mesh_leaves_no_directory(tmp_path):
+    bad = tmp_path / "bad.obj"
+    bad.write_text("v 0 0 0\nf 1 2 3\n")
+    out = tmp_path / "levels"
+    result = run_lod(bad, out)
+    assert result.returncode == 1
+    errors = [line for line in result.stderr.splitlines() if "error:" in line]
+    assert len(errors) == 1 and "bad.obj: face 0 references vertex 2" in errors[0]
+    assert not out.exists()  # made for the run, removed when it failed before writing a level
