@@ -1,11 +1,11 @@
 // `vertexflow enhance IN OUT [...]`: the enhance engine (enhance.h) on files: parsing, reading,
 // writing, printing, and the JSON and HTML reports of what it did.
 #include "cli_common.h"
-#include "memory_estimate.h"
 #include "progress.h"
 
 #include "vertexflow/enhance.h"
 #include "vertexflow/html_report.h"
+#include "vertexflow/memory.h"
 #include "vertexflow/provenance.h"
 #include "vertexflow/timing.h"
 
@@ -196,7 +196,7 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
       reference.emplace(std::move(dense.V), std::move(dense.F), o->reference_file);
     }
     const ReferenceSurface* reference_pointer = reference ? &*reference : nullptr;
-    // One line now rather than the OOM killer later (memory_estimate.h).
+    // One line now rather than the OOM killer later (vertexflow/memory.h).
     require_memory_for_enhance(o->input, mesh.num_vertices(), !o->report_file.empty() || !o->html_file.empty(),
                                reference ? static_cast<Index>(reference->vertices().rows()) : 0);
     // Trees over the reference's faces that the run and its report build (reference_surface.h).

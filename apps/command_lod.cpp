@@ -2,10 +2,10 @@
 // [--force]`: levels of detail of DENSE, each QEM then reference mode against DENSE (lod.h), one
 // mesh per level and a summary in JSON and Markdown (docs/lod.md).
 #include "cli_common.h"
-#include "memory_estimate.h"
 #include "progress.h"
 
 #include "vertexflow/lod.h"
+#include "vertexflow/memory.h"
 #include "vertexflow/render.h"
 #include "vertexflow/timing.h"
 

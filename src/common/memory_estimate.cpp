@@ -1,5 +1,5 @@
-// Memory estimate before a run (memory_estimate.h).
-#include "memory_estimate.h"
+// Memory estimate before a run (memory.h).
+#include "vertexflow/memory.h"
 
 #include <fmt/format.h>
 
@@ -10,7 +10,7 @@
 #include <sstream>
 #include <stdexcept>
 
-namespace vertexflow::cli {
+namespace vertexflow {
 namespace {
 
 // Measured peaks per vertex (docs/benchmarks.md, "Memory by phase" and "After the first
@@ -91,11 +91,11 @@ void require_memory_for_enhance(const std::string& path, Index vertices, bool wi
   const std::uint64_t held = resident_bytes();
   const std::uint64_t more = estimate > held ? estimate - held : 0;
   if (more <= available->bytes) return;
-  throw std::runtime_error(
+  throw InsufficientMemoryError(
       fmt::format("{}: enhancing {} vertices{} needs about {:.2f} GiB at its peak (estimated from measured runs, "
                   "docs/benchmarks.md; {:.2f} GiB of it held already), but only {:.2f} GiB more is available ({})",
                   path, vertices, with_report ? " with a report" : "", gib(estimate), gib(held), gib(available->bytes),
                   available->limited_by));
 }
 
-}  // namespace vertexflow::cli
+}  // namespace vertexflow
