@@ -3,6 +3,7 @@
 
 #include "vertexflow/enhance_options.h"
 #include "vertexflow/io.h"
+#include "vertexflow/memory.h"
 #include "vertexflow/timing.h"
 
 #include <fmt/format.h>
@@ -96,6 +97,11 @@ void run_file(const std::filesystem::path& input, const std::filesystem::path& o
   row.seconds_read = seconds_since(start);
   row.vertices = mesh.num_vertices();
   row.faces = mesh.num_faces();
+
+  // A file that would not fit is this file's error, one line naming it, and the batch goes on
+  // (memory.h); with metrics, the estimate counts the report's peak, as `enhance --report` does.
+  require_memory_for_enhance(input.string(), mesh.num_vertices(), options.metrics,
+                             reference ? static_cast<Index>(reference->vertices().rows()) : 0);
 
   start = Clock::now();
   const ReferenceSurface* reference_pointer = reference ? &*reference : nullptr;
