@@ -2,6 +2,7 @@
 #include "convert.h"
 
 #include "vertexflow/io.h"
+#include "vertexflow/memory.h"
 
 #include <algorithm>
 #include <cmath>
@@ -381,6 +382,9 @@ void register_exception_translators() {
       if (p) std::rethrow_exception(p);
     } catch (const IoError& e) {
       PyErr_SetString(PyExc_OSError, e.what());
+    } catch (const InsufficientMemoryError& e) {
+      // A run that would not fit (memory.h): MemoryError, its one line unchanged.
+      PyErr_SetString(PyExc_MemoryError, e.what());
     }
   });
 }

@@ -5,6 +5,7 @@
 
 #include "vertexflow/enhance_options.h"
 #include "vertexflow/io.h"
+#include "vertexflow/memory.h"
 #include "vertexflow/reference_surface.h"
 
 #include <chrono>
@@ -50,6 +51,10 @@ py::tuple py_enhance(const py::handle& V, const py::handle& F, const py::dict& g
   const bool has_reference = !reference.is_none();
   validate_enhance_options(options, has_reference, mesh.num_vertices(), OptionNaming::Python);
   const std::optional<ReferenceSurface> dense = reference_from(reference);
+  // A run that would not fit raises MemoryError now, one line, rather than the OOM killer later
+  // (memory.h). The arrays have no path; "enhance" names the call. No report's metrics here.
+  require_memory_for_enhance("enhance", mesh.num_vertices(), /*with_report=*/false,
+                             dense ? static_cast<Index>(dense->vertices().rows()) : 0);
 
   const char* mode = enhance_mode_name(enhance_mode(options, has_reference));
   if (!progress.is_none())

@@ -1,0 +1,69 @@
+"""vertexflow.enhance refuses a run that would not fit before it starts (issue 29): MemoryError with
+the library's one line (vertexflow/memory.h), as the CLI refuses it, instead of being killed by the
+OOM killer halfway. Each case runs in a subprocess that limits its own address space (RLIMIT_AS,
+`ulimit -v`) to what it maps after importing the module plus HEADROOM."""
+
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+from conftest import DATA
+
+# 1,000,000 vertices need about 1.49 GiB by the estimate (1,600 B per vertex), far more than the
+# headroom; sphere_low (589 vertices) runs within it.
+HEADROOM_MB = 768
+
+CHILD = r"""
+import json, resource, sys
+import numpy as np
+import vertexflow
+
+def vm_size():
+    with open("/proc/self/status") as status:
+        for line in status:
+            if line.startswith("VmSize:"):
+                return int(line.split()[1]) * 1024
+    raise RuntimeError("no VmSize")
+
+headroom, mesh = int(sys.argv[1]) * 1024 * 1024, sys.argv[2]
+if mesh == "grid":
+    n = 1000  # n * n vertices, two triangles per cell
+    x, y = np.meshgrid(np.arange(n, dtype=np.float64), np.arange(n, dtype=np.float64))
+    V = np.column_stack([x.ravel(), y.ravel(), np.zeros(n * n)])
+    i = (np.arange(n - 1)[:, None] * n + np.arange(n - 1)[None, :]).ravel().astype(np.int32)
+    F = np.concatenate([np.column_stack([i, i + 1, i + n]), np.column_stack([i + 1, i + n + 1, i + n])])
+else:
+    V, F = vertexflow.read_mesh(mesh)
+limit = vm_size() + headroom
+resource.setrlimit(resource.RLIMIT_AS, (limit, resource.getrlimit(resource.RLIMIT_AS)[1]))
+try:
+    out = vertexflow.enhance(V, F)
+    print(json.dumps({"ok": len(out[0])}))
+except MemoryError as e:
+    print(json.dumps({"MemoryError": str(e)}))
+"""
+
+
+def run_child(mesh: str) -> dict:
+    r = subprocess.run([sys.executable, "-c", CHILD, str(HEADROOM_MB), mesh], capture_output=True, text=True,
+                       timeout=300, env=dict(os.environ))
+    assert r.returncode == 0, r.stderr
+    return json.loads(r.stdout.strip().splitlines()[-1])
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="RLIMIT_AS and /proc are Linux's")
+def test_enhance_that_would_not_fit_raises_memory_error_with_one_line():
+    result = run_child("grid")
+    assert "MemoryError" in result, result
+    message = result["MemoryError"]
+    assert message.startswith("enhance: enhancing 1000000 vertices needs about "), message
+    assert "but only " in message and "GiB more is available (" in message, message
+    assert "\n" not in message
+
+
+@pytest.mark.skipif(not sys.platform.startswith("linux"), reason="RLIMIT_AS and /proc are Linux's")
+def test_enhance_that_fits_runs_under_the_same_limit():
+    assert run_child(str(DATA / "sphere_low.off")) == {"ok": 589}
