@@ -1,5 +1,7 @@
 #include "cli_common.h"
 
+#include "vertexflow/remesh_report_json.h"
+
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
@@ -118,11 +120,7 @@ std::string describe_format(const ReadReport& report) {
 }
 
 nlohmann::json to_json(const SurfaceRepairs& repairs) {
-  return {{"input_split_vertices", repairs.input_split.held_vertices},
-          {"input_reoriented_faces", repairs.input_split.reversed_faces},
-          {"input_cut_edges", repairs.input_split.cut_edges},
-          {"removed_degenerate_faces", repairs.removed_degenerate_faces},
-          {"duplicated_vertices", repairs.duplicated_vertices}};
+  return surface_repairs_json(repairs);
 }
 
 void warn_about_repairs(const std::string& input, const SurfaceRepairs& repairs, const GlobalOptions& global) {

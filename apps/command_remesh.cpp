@@ -5,6 +5,7 @@
 
 #include "vertexflow/quality.h"
 #include "vertexflow/remesh.h"
+#include "vertexflow/remesh_report_json.h"
 
 #include <fmt/format.h>
 
@@ -140,47 +141,10 @@ void register_remesh_command(CLI::App& app, const GlobalOptions& global) {
     write_mesh(o->output, result.mesh);
     progress.finish();
     if (o->json) {
-      nlohmann::json out;
+      // The library's report (remesh_report_json.h, shared with Python) and the file names.
+      nlohmann::json out = remesh_report_json(result, mesh.num_vertices(), o->remesh, searched);
       out["input"] = o->input;
       out["output"] = o->output;
-      out["input_vertices"] = mesh.num_vertices();
-      out["vertices"] = result.mesh.num_vertices();
-      out["faces"] = result.mesh.num_faces();
-      if (searched) {
-        out["target_vertices"] = o->remesh.target_vertices;
-        out["tolerance"] = o->remesh.tolerance;
-        out["within_tolerance"] = r.within_tolerance;
-      }
-      out["edge_length"] = r.edge_length;
-      out["runs"] = nlohmann::json::array();
-      for (const RemeshAttempt& a : r.attempts)
-        out["runs"].push_back({{"edge_length", a.edge_length}, {"vertices", a.vertices}, {"seconds", a.seconds}});
-      out["iterations"] = o->remesh.isotropic.iterations;
-      out["protect_boundary"] = o->remesh.isotropic.protect_boundary;
-      out["seconds"] = r.seconds;
-      out["quality"] = nlohmann::json(quality);
-      out["quality_interior"] = nlohmann::json(r.quality.interior);
-      out["quality_rim"] = nlohmann::json(r.quality.rim);
-      out["interior_faces"] = r.quality.interior_faces;
-      out["rim_faces"] = r.quality.rim_faces;
-      out["components"] = r.quality.components;
-      out["boundary_loops"] = r.quality.boundary_loops;
-      out["non_manifold_vertices"] = r.quality.non_manifold_vertices;
-      out["zero_area_faces"] = r.quality.zero_area_faces;
-      out["min_edge_length"] = r.quality.min_edge_length;
-      out["small_piece_edges"] = o->remesh.isotropic.small_piece_edges;
-      out["short_loop_edges"] = o->remesh.isotropic.short_loop_edges;
-      out["fill_hole_edges"] = o->remesh.isotropic.fill_hole_edges;
-      out["cleanup"] = {{"small_pieces", cleanup.small_pieces},
-                        {"small_piece_faces", cleanup.small_piece_faces},
-                        {"small_pieces_kept", cleanup.small_pieces_kept},
-                        {"short_loops_kept", cleanup.short_loops},
-                        {"held_loop_vertices", cleanup.held_loop_vertices},
-                        {"filled_holes", cleanup.filled_holes},
-                        {"collapsed_short_edges", cleanup.collapsed_short_edges},
-                        {"flipped_cap_edges", cleanup.flipped_cap_edges},
-                        {"removed_cap_faces", cleanup.removed_cap_faces}};
-      out["repairs"] = to_json(r.repairs);
       fmt::print("{}\n", out.dump(2));
     }
   });

@@ -1,6 +1,7 @@
 #include "vertexflow/report_json.h"
 
 #include "vertexflow/enhance_options.h"
+#include "vertexflow/remesh_report_json.h"
 
 #include <nlohmann/json.hpp>
 
@@ -166,6 +167,66 @@ nlohmann::json distance_stats_json(const DistanceStats& stats, double length_sca
 
 void to_json(nlohmann::json& j, const SmoothSurfaceOptions& options) {
   j = {{"segments", options.segments}, {"feature_angle", options.feature_angle}};
+}
+
+// The remesh report (remesh_report_json.h): `vertexflow remesh --json` and Python's
+// remesh(..., report=True).
+
+nlohmann::json surface_repairs_json(const SurfaceRepairs& repairs) {
+  return {{"input_split_vertices", repairs.input_split.held_vertices},
+          {"input_reoriented_faces", repairs.input_split.reversed_faces},
+          {"input_cut_edges", repairs.input_split.cut_edges},
+          {"removed_degenerate_faces", repairs.removed_degenerate_faces},
+          {"duplicated_vertices", repairs.duplicated_vertices}};
+}
+
+nlohmann::json remesh_cleanup_json(const RemeshCleanup& cleanup) {
+  return {{"small_pieces", cleanup.small_pieces},
+          {"small_piece_faces", cleanup.small_piece_faces},
+          {"small_pieces_kept", cleanup.small_pieces_kept},
+          {"short_loops_kept", cleanup.short_loops},
+          {"held_loop_vertices", cleanup.held_loop_vertices},
+          {"filled_holes", cleanup.filled_holes},
+          {"collapsed_short_edges", cleanup.collapsed_short_edges},
+          {"flipped_cap_edges", cleanup.flipped_cap_edges},
+          {"removed_cap_faces", cleanup.removed_cap_faces}};
+}
+
+nlohmann::json remesh_report_json(const RemeshResult& result, Index input_vertices, const RemeshOptions& options,
+                                  bool searched) {
+  const RemeshReport& r = result.report;
+  nlohmann::json out;
+  out["input_vertices"] = input_vertices;
+  out["vertices"] = result.mesh.num_vertices();
+  out["faces"] = result.mesh.num_faces();
+  if (searched) {
+    out["target_vertices"] = options.target_vertices;
+    out["tolerance"] = options.tolerance;
+    out["within_tolerance"] = r.within_tolerance;
+  }
+  out["edge_length"] = r.edge_length;
+  out["runs"] = nlohmann::json::array();
+  for (const RemeshAttempt& a : r.attempts)
+    out["runs"].push_back({{"edge_length", a.edge_length}, {"vertices", a.vertices}, {"seconds", a.seconds}});
+  out["iterations"] = options.isotropic.iterations;
+  out["protect_boundary"] = options.isotropic.protect_boundary;
+  out["seconds"] = r.seconds;
+  out["quality"] = nlohmann::json(r.quality.all);
+  out["quality_interior"] = nlohmann::json(r.quality.interior);
+  out["quality_rim"] = nlohmann::json(r.quality.rim);
+  out["interior_faces"] = r.quality.interior_faces;
+  out["rim_faces"] = r.quality.rim_faces;
+  out["components"] = r.quality.components;
+  out["boundary_loops"] = r.quality.boundary_loops;
+  out["non_manifold_vertices"] = r.quality.non_manifold_vertices;
+  out["zero_area_faces"] = r.quality.zero_area_faces;
+  out["min_edge_length"] = r.quality.min_edge_length;
+  out["small_piece_edges"] = options.isotropic.small_piece_edges;
+  out["short_loop_edges"] = options.isotropic.short_loop_edges;
+  out["fill_hole_edges"] = options.isotropic.fill_hole_edges;
+  out["cleanup"] = remesh_cleanup_json(r.cleanup);
+  out["repairs"] = surface_repairs_json(r.repairs);
+  return out;
 }
 
 }  // namespace vertexflow

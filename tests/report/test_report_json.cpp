@@ -3,6 +3,7 @@
 // Each test binds every field of its struct by name (a structured binding needs exactly as
 // many names as the struct has fields), so adding a field stops this file from compiling until
 // the field is named here, given a non-default value and expected in the JSON.
+#include "vertexflow/remesh_report_json.h"
 #include "vertexflow/report_json.h"
 
 #include <gtest/gtest.h>
@@ -189,5 +190,84 @@ TEST(ReportJson, UnsharpOptionsAndResultEveryField) {
                                     {"held_vertices": 4, "reoriented_faces": 5, "cut_edges": 6}})"));
 }
 
+// remesh_report_json.h: what `vertexflow remesh --json` prints and Python's remesh(report=True)
+// returns. Every field of RemeshCleanup, SurfaceRepairs and RemeshQuality, each value its own.
+TEST(ReportJson, RemeshReportEveryField) {
+  RemeshResult result;
+  result.mesh.V = Vertices::Zero(5, 3);
+  result.mesh.F = Faces::Zero(7, 3);
+  RemeshReport& r = result.report;
+  r.attempts = {{0.5, 4, 0.25}, {0.625, 5, 0.375}};
+  r.edge_length = 0.625;
+  r.within_tolerance = true;
+  r.seconds = 0.75;
+  auto& [input_split, removed_degenerate_faces, duplicated_vertices] = r.repairs;
+  auto& [held_vertices, reversed_faces, cut_edges] = input_split;
+  held_vertices = 1;
+  reversed_faces = 2;
+  cut_edges = 3;
+  removed_degenerate_faces = 4;
+  duplicated_vertices = 5;
+  auto& [small_pieces, small_piece_faces, small_pieces_kept, short_loops, held_loop_vertices, filled_holes,
+         collapsed_short_edges, flipped_cap_edges, removed_cap_faces] = r.cleanup;
+  small_pieces = 11;
+  small_piece_faces = 12;
+  small_pieces_kept = true;
+  short_loops = 13;
+  held_loop_vertices = 14;
+  filled_holes = 15;
+  collapsed_short_edges = 16;
+  flipped_cap_edges = 17;
+  removed_cap_faces = 18;
+  auto& [all, interior, rim, interior_faces, rim_faces, components, boundary_loops, non_manifold_vertices,
+         zero_area_faces, min_edge_length] = r.quality;
+  all.min = 0.125;
+  interior.min = 0.25;
+  rim.min = 0.375;
+  interior_faces = 21;
+  rim_faces = 22;
+  components = 23;
+  boundary_loops = 24;
+  non_manifold_vertices = 25;
+  zero_area_faces = 26;
+  min_edge_length = 0.0625;
+  RemeshOptions options;
+  options.target_vertices = 6;
+  options.tolerance = 0.5;
+  options.isotropic.iterations = 3;
+  options.isotropic.protect_boundary = true;
+  options.isotropic.small_piece_edges = 4.5;
+  options.isotropic.short_loop_edges = 5.5;
+  options.isotropic.fill_hole_edges = 6.5;
+
+  nlohmann::json expected = nlohmann::json::parse(R"({
+    "input_vertices": 40, "vertices": 5, "faces": 7, "target_vertices": 6, "tolerance": 0.5,
+    "within_tolerance": true, "edge_length": 0.625,
+    "runs": [{"edge_length": 0.5, "vertices": 4, "seconds": 0.25},
+             {"edge_length": 0.625, "vertices": 5, "seconds": 0.375}],
+    "iterations": 3, "protect_boundary": true, "seconds": 0.75,
+    "interior_faces": 21, "rim_faces": 22, "components": 23, "boundary_loops": 24,
+    "non_manifold_vertices": 25, "zero_area_faces": 26, "min_edge_length": 0.0625,
+    "small_piece_edges": 4.5, "short_loop_edges": 5.5, "fill_hole_edges": 6.5,
+    "cleanup": {"small_pieces": 11, "small_piece_faces": 12, "small_pieces_kept": true,
+                "short_loops_kept": 13, "held_loop_vertices": 14, "filled_holes": 15,
+                "collapsed_short_edges": 16, "flipped_cap_edges": 17, "removed_cap_faces": 18},
+    "repairs": {"input_split_vertices": 1, "input_reoriented_faces": 2, "input_cut_edges": 3,
+                "removed_degenerate_faces": 4, "duplicated_vertices": 5}})");
+  expected["quality"] = nlohmann::json(all);
+  expected["quality_interior"] = nlohmann::json(interior);
+  expected["quality_rim"] = nlohmann::json(rim);
+  const nlohmann::json j = remesh_report_json(result, 40, options, /*searched=*/true);
+  EXPECT_EQ(j, expected);
+  expect_every_value_differs(j["cleanup"], remesh_cleanup_json(RemeshCleanup{}));
+  expect_every_value_differs(j["repairs"], surface_repairs_json(SurfaceRepairs{}));
+  EXPECT_NE(j["quality"], j["quality_interior"]);
+  EXPECT_NE(j["quality_interior"], j["quality_rim"]);
+
+  // A run at one edge length (remesh_to_edge_length) searched no count: no target, tolerance or
+  // within_tolerance.
+  for (const char* key : {"target_vertices", "tolerance", "within_tolerance"}) expected.erase(key);
+  EXPECT_EQ(remesh_report_json(result, 40, options, /*searched=*/false), expected);
+}
 }  // namespace
 }  // namespace vertexflow
