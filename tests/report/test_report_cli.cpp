@@ -131,7 +131,7 @@ TEST(CliReport, EnhanceReportHoldsTheFlowsOptionsAndReport) {
   EXPECT_FALSE(report["hold"]["held"]);  // fandisk is neither decimated nor a control mesh (input_check.h)
   EXPECT_EQ(report["provenance"], "vertexflow enhance --surface input");  // the line added to OUT (provenance.h)
   EXPECT_EQ(keys(report["seconds"]), (std::set<std::string>{"read", "curvature", "assembly", "solve", "factorization",
-                                                            "projection", "guard", "density", "write"}));
+                                                            "projection", "guard", "density", "set_up", "write"}));
   const Mesh mesh = read_mesh(input);
   const FlowResult flow = vertex_flow(mesh.V, mesh.F, options);
   const nlohmann::json expected = flow.report;
