@@ -88,8 +88,9 @@ struct FitReport {
   /// Smooth mode: building the patches (0 in reference mode); seconds_tree is then the
   /// system's set-up.
   double seconds_surface = 0;
-  /// Smooth mode: the fraction of the input's faces below quality 0.3, and whether it was held
-  /// as decimated for exceeding SmoothFitOptions::max_poor_face_fraction (returned unchanged).
+  /// Smooth mode: the fraction of the input's interior faces (input_check.h) below quality
+  /// 0.3, and whether it was held as decimated for exceeding
+  /// SmoothFitOptions::max_poor_face_fraction (returned unchanged).
   double poor_face_fraction = 0;
   bool held_as_decimated = false;
   /// Smooth mode: the share of the input's interior edges sharper than kSharpEdgeAngle
@@ -143,8 +144,9 @@ Mesh smooth_surface_estimate(const Vertices& V, const Faces& F, const SmoothSurf
 /// models got 26-100% worse. Geometry alone cannot tell the two apart (a sphere's inscribed and
 /// best-fitting meshes are the same mesh at two scales), but decimation leaves a mark that
 /// remeshing and scanning do not: thin triangles. Inputs with more than
-/// max_poor_face_fraction of their faces below quality 0.3 (triangle_quality, quality.h) are
-/// therefore held as decimated: returned unchanged, with FitReport::held_as_decimated set.
+/// max_poor_face_fraction of their interior faces (no corner on a boundary edge, input_check.h)
+/// below quality 0.3 (triangle_quality, quality.h) are therefore held as decimated: returned
+/// unchanged, with FitReport::held_as_decimated set.
 /// Measured fractions: 2.95-20.5% on QEM outputs of 9 data meshes at 10% and 25% of their faces,
 /// 0% on the remeshes, at most 1.9% on the data meshes that are not decimated (fertility);
 /// camelhead (7.6%) and max-planck-5k (8.8%) are decimated scans. The control mesh of a

@@ -14,10 +14,14 @@
 //     the limit surface by 9-47% on Loop and Catmull-Clark pairs made from data/.
 // Geometry alone cannot tell such a mesh from one whose vertices do lie on a surface (a sphere's
 // inscribed and best-fitting meshes are the same mesh at two scales). What it can tell:
-//   - poor_face_fraction: the share of faces below quality 0.3 (triangle_quality, quality.h).
-//     Decimation leaves them, remeshing and scanning do not: 4.0-20.5% on QEM outputs of 9 data/
-//     meshes at 10% and 25% of their faces (amo at 25%: 2.95%), 0-0.05% on remeshes, at most
-//     1.93% on the data/ meshes that are not decimated (fertility).
+//   - poor_face_fraction: the share of interior faces below quality 0.3 (triangle_quality,
+//     quality.h), where a face is interior when none of its corners is on a boundary edge.
+//     Decimation leaves such faces everywhere, remeshing and scanning do not: 4.0-20.5% on QEM
+//     outputs of 9 data/ meshes at 10% and 25% of their faces (amo at 25%: 2.95%), 0-0.05% on
+//     remeshes, at most 1.93% on the data/ meshes that are not decimated (fertility). Rim faces
+//     are left out because a remesh of a scan with hundreds of holes far below its edge length
+//     has needles around them and nowhere else (docs/remesh.md: 12.6% of the rim faces, 0% of
+//     the interior ones, of a bunny scan with 650 holes); smooth mode gains 18% on it.
 //   - sharp_edge_fraction: the share of interior edges whose two faces turn by more than
 //     kSharpEdgeAngle (the methods' default feature angle). A cage is coarse for its shape, so
 //     many of its edges turn that far: 11.4-100% on the cages of the pairs; at most 5.1% on the
@@ -53,7 +57,11 @@ enum class HoldReason { None, Decimated, ControlMesh, AlreadyFitted };
 const char* hold_reason_name(HoldReason reason);
 
 struct InputCheck {
-  double poor_face_fraction = 0;   ///< share of faces below quality 0.3, in [0, 1]
+  /// Share of the interior faces (no corner on a boundary edge) below quality 0.3, in [0, 1];
+  /// over all faces when every face has a corner on a boundary edge.
+  double poor_face_fraction = 0;
+  Index interior_faces = 0;        ///< faces with no corner on a boundary edge
+  Index rim_faces = 0;             ///< faces with a corner on a boundary edge
   double sharp_edge_fraction = 0;  ///< share of interior edges sharper than kSharpEdgeAngle
   Index interior_edges = 0;        ///< edges with exactly two faces (the fraction's denominator)
   /// Decimated when poor_face_fraction exceeds its threshold, else a control mesh when
@@ -61,8 +69,9 @@ struct InputCheck {
   HoldReason reason = HoldReason::None;
 };
 
-/// Measures (V, F) as above. Faces with a repeated vertex or zero area count in the quality share
-/// (their quality is 0) and not among the interior edges' faces. Throws std::invalid_argument
+/// Measures (V, F) as above. A boundary edge is an edge of exactly one face with three distinct
+/// corners. Faces with a repeated vertex or zero area count in the quality share (their quality
+/// is 0) and not among the interior edges' faces. Throws std::invalid_argument
 /// for a threshold outside [0, 1].
 InputCheck check_input(const Vertices& V, const Faces& F, const InputCheckOptions& options = {});
 

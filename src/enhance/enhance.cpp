@@ -229,7 +229,7 @@ void warn_about_hold(const Hold& hold, EnhanceMode mode, const std::string* fitt
       break;
     case HoldReason::Decimated:
       why = fmt::format(
-          "{:.1f}% of the faces are below quality 0.3 (over {:g}%): a decimated mesh, whose vertices lie "
+          "{:.1f}% of the interior faces are below quality 0.3 (over {:g}%): a decimated mesh, whose vertices lie "
           "off the surface",
           100 * hold.poor_face_fraction, 100 * kMaxPoorFaceFraction);
       break;

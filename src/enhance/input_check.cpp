@@ -38,7 +38,6 @@ InputCheck check_input(const Vertices& V, const Faces& F, const InputCheckOption
   for (const double t : {options.max_poor_face_fraction, options.max_sharp_edge_fraction})
     if (!(t >= 0 && t <= 1)) throw std::invalid_argument("input check: thresholds must be in [0, 1]");
   InputCheck check;
-  check.poor_face_fraction = summarize_quality(triangle_quality(V, F)).fraction_below_0_3;
 
   // Unit normals; faces without area get none, and their edges are left out.
   const Index m = F.rows();
@@ -54,11 +53,12 @@ InputCheck check_input(const Vertices& V, const Faces& F, const InputCheckOption
       has_normal[static_cast<std::size_t>(f)] = 1;
     }
   }
-  // Each edge's sides, sorted so an edge's faces are adjacent (deterministic, no hashing).
+  // Each edge's sides (faces with three distinct corners), sorted so an edge's faces are
+  // adjacent (deterministic, no hashing).
   std::vector<EdgeSide> sides;
   sides.reserve(static_cast<std::size_t>(3 * m));
   for (Index f = 0; f < m; ++f)
-    if (has_normal[static_cast<std::size_t>(f)])
+    if (F(f, 0) != F(f, 1) && F(f, 1) != F(f, 2) && F(f, 2) != F(f, 0))
       for (int k = 0; k < 3; ++k) {
         const Index u = F(f, k), w = F(f, (k + 1) % 3);
         sides.push_back({std::min(u, w), std::max(u, w), f});
@@ -66,19 +66,49 @@ InputCheck check_input(const Vertices& V, const Faces& F, const InputCheckOption
   std::sort(sides.begin(), sides.end());
   const double cos_sharp = std::cos(kSharpEdgeAngle * std::numbers::pi / 180);
   Index sharp = 0;
+  std::vector<char> on_boundary(static_cast<std::size_t>(V.rows()), 0);
   for (std::size_t i = 0; i < sides.size();) {
     std::size_t j = i + 1;
     while (j < sides.size() && sides[j].a == sides[i].a && sides[j].b == sides[i].b) ++j;
-    if (j - i == 2) {
+    if (j - i == 1)
+      on_boundary[static_cast<std::size_t>(sides[i].a)] = on_boundary[static_cast<std::size_t>(sides[i].b)] = 1;
+    // The interior edges of the sharp share: two sides that have a normal.
+    Index with_normal[2] = {0, 0};
+    std::size_t count = 0;
+    for (std::size_t k = i; k < j; ++k)
+      if (has_normal[static_cast<std::size_t>(sides[k].face)]) {
+        if (count < 2) with_normal[count] = sides[k].face;
+        ++count;
+      }
+    if (count == 2) {
       ++check.interior_edges;
       const double c =
-          normal[static_cast<std::size_t>(sides[i].face)].dot(normal[static_cast<std::size_t>(sides[i + 1].face)]);
+          normal[static_cast<std::size_t>(with_normal[0])].dot(normal[static_cast<std::size_t>(with_normal[1])]);
       if (c < cos_sharp) ++sharp;
     }
     i = j;
   }
   if (check.interior_edges > 0)
     check.sharp_edge_fraction = static_cast<double>(sharp) / static_cast<double>(check.interior_edges);
+
+  const Eigen::VectorXd quality = triangle_quality(V, F);
+  Index poor_interior = 0, poor_all = 0;
+  for (Index f = 0; f < m; ++f) {
+    const bool rim = on_boundary[static_cast<std::size_t>(F(f, 0))] || on_boundary[static_cast<std::size_t>(F(f, 1))] ||
+                     on_boundary[static_cast<std::size_t>(F(f, 2))];
+    const bool poor = quality[f] < 0.3;  // summarize_quality's fraction_below_0_3
+    poor_all += poor;
+    if (rim) {
+      ++check.rim_faces;
+    } else {
+      ++check.interior_faces;
+      poor_interior += poor;
+    }
+  }
+  if (check.interior_faces > 0)
+    check.poor_face_fraction = static_cast<double>(poor_interior) / static_cast<double>(check.interior_faces);
+  else if (m > 0)
+    check.poor_face_fraction = static_cast<double>(poor_all) / static_cast<double>(m);
 
   if (check.poor_face_fraction > options.max_poor_face_fraction)
     check.reason = HoldReason::Decimated;

@@ -3,12 +3,14 @@
 // "hold" section, and assume_on_surface runs them anyway, as vertex_flow and the smooth fit do on
 // their own. The truths are made here: a QEM simplification of a data mesh has that mesh, and a
 // control mesh has its CGAL Loop subdivision.
+#include "shapes.h"
 #include "test_support.h"
 
 #include "vertexflow/distance.h"
 #include "vertexflow/enhance.h"
 #include "vertexflow/input_check.h"
 #include "vertexflow/io.h"
+#include "vertexflow/quality.h"
 #include "vertexflow/simplify.h"
 
 #include <CGAL/Simple_cartesian.h>
@@ -108,6 +110,39 @@ TEST(InputCheck, MeasuresDecimationAndControlMeshes) {
     EXPECT_LT(check.sharp_edge_fraction, kMaxSharpEdgeFraction / 2) << name;
   }
   EXPECT_THROW(check_input(suzanne.V, suzanne.F, {1.5, 0.1}), std::invalid_argument);
+}
+
+// The poor-face share counts interior faces only (no corner on a boundary edge): needles at a
+// rim are what a remesh leaves around holes far below its edge, not the mark of decimation. A
+// flat 30 x 30 grid gets needles by moving one row of vertices to 2% of a cell from a line of
+// the grid: at the border (rim faces only) it is not held, one row inside it is.
+TEST(InputCheck, CountsPoorFacesAwayFromTheBoundary) {
+  constexpr int n = 30;
+  const auto grid_with_needles_at_row = [&](int row) {
+    Mesh grid = test::height_field(1.0, n, [](double, double) { return 0.0; });
+    const double cell = 2.0 / n;
+    for (int j = 0; j <= n; ++j) grid.V(row * (n + 1) + j, 0) = grid.V((row - 1) * (n + 1) + j, 0) + 0.02 * cell;
+    return grid;
+  };
+  const Mesh at_rim = grid_with_needles_at_row(1);
+  const InputCheck rim = check_input(at_rim.V, at_rim.F);
+  const double overall = summarize_quality(triangle_quality(at_rim.V, at_rim.F)).fraction_below_0_3;
+  EXPECT_EQ(rim.rim_faces, 2 * (4 * n - 4));  // both faces of each of the 4n - 4 cells on the border
+  EXPECT_EQ(rim.interior_faces + rim.rim_faces, at_rim.num_faces());
+  EXPECT_GT(overall, kMaxPoorFaceFraction);  // 2n needles of 2n^2 faces: 3.3%
+  EXPECT_EQ(rim.poor_face_fraction, 0);
+  EXPECT_EQ(rim.reason, HoldReason::None);
+
+  const Mesh inside = grid_with_needles_at_row(2);
+  const InputCheck held = check_input(inside.V, inside.F);
+  EXPECT_GT(held.poor_face_fraction, kMaxPoorFaceFraction);
+  EXPECT_EQ(held.reason, HoldReason::Decimated);
+
+  // A closed mesh has no rim: the share is over every face.
+  const Mesh spot = read_mesh(test::data_path("spot.obj"));
+  const InputCheck closed = check_input(spot.V, spot.F);
+  EXPECT_EQ(closed.rim_faces, 0);
+  EXPECT_EQ(closed.poor_face_fraction, summarize_quality(triangle_quality(spot.V, spot.F)).fraction_below_0_3);
 }
 
 // The decimated input: the flow (and its density passes) and smooth mode hold it, saying why;

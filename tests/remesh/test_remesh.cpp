@@ -4,7 +4,10 @@
 #include "shapes.h"
 #include "test_support.h"
 
+#include "vertexflow/distance.h"
+#include "vertexflow/enhance.h"
 #include "vertexflow/flow.h"
+#include "vertexflow/input_check.h"
 #include "vertexflow/io.h"
 #include "vertexflow/quality.h"
 #include "vertexflow/remesh.h"
@@ -506,6 +509,45 @@ TEST(RemeshRawScan, QualityIsSplitIntoRimAndInteriorFaces) {
   EXPECT_EQ(closed.rim_faces, 0);
   EXPECT_EQ(closed.interior_faces, sphere.num_faces());
   EXPECT_EQ(closed.interior.mean, closed.all.mean);
+}
+
+// Issue 31: a scan with hundreds of holes far below the target edge (docs/remesh.md). Its remesh
+// has needles around the tiny holes and nowhere else; the input check counts interior faces only,
+// so smooth mode takes the remesh instead of holding it as decimated, and gains.
+TEST(RemeshRawScan, SmoothModeTakesARemeshWhosePoorFacesAreAllAtTinyHoles) {
+  test::RawScanOptions tiny;
+  tiny.subdivisions = 1;
+  tiny.holes = 650;
+  tiny.hole_radius_min = 0.05;
+  tiny.hole_radius_max = 0.5;
+  const Mesh dense = read_mesh(test::data_path("bunny.off"));
+  const test::RawScan scan = test::make_raw_scan(dense, tiny);
+  RemeshOptions options;
+  options.target_vertices = 6000;
+  const Mesh remeshed = remesh_to_vertex_count(scan.mesh.V, scan.mesh.F, options).mesh;
+
+  const InputCheck check = check_input(remeshed.V, remeshed.F);
+  const double poor_overall = summarize_quality(triangle_quality(remeshed.V, remeshed.F)).fraction_below_0_3;
+  std::cout << "[measured] remesh of a scan with 650 tiny holes: below 0.3 " << poor_overall << " of all faces, "
+            << check.poor_face_fraction << " of " << check.interior_faces << " interior faces (" << check.rim_faces
+            << " rim faces)\n";
+  EXPECT_GT(check.rim_faces, remeshed.num_faces() / 3);  // measured 5534 of 11586
+  EXPECT_EQ(check.interior_faces + check.rim_faces, remeshed.num_faces());
+  // Counted over all faces the remesh would look decimated (measured 4.3%)...
+  EXPECT_GT(poor_overall, kMaxPoorFaceFraction);
+  // ...but its interior is clean (measured 0), so it is not held.
+  EXPECT_LT(check.poor_face_fraction, kMaxPoorFaceFraction / 5);
+  EXPECT_EQ(check.reason, HoldReason::None);
+
+  EnhanceOptions smooth;
+  smooth.surface = EnhanceSurface::Smooth;
+  const EnhanceResult result = enhance(remeshed, nullptr, smooth);
+  EXPECT_EQ(result.report["fit"]["held_as_decimated"], false);
+  const double before = symmetric_distance(remeshed.V, remeshed.F, dense.V, dense.F).mean();
+  const double after = symmetric_distance(result.mesh.V, result.mesh.F, dense.V, dense.F).mean();
+  std::cout << "[measured] smooth mode: two-sided mean distance to bunny.off " << before << " -> " << after << "\n";
+  EXPECT_LT(after, 0.95 * before);  // issue 31 asks for 5%; measured -18.5%
+  EXPECT_TRUE(flipped_faces(remeshed.V, result.mesh.V, remeshed.F).empty());
 }
 
 TEST(Remesh, NonManifoldInputIsRemeshedThroughItsSplit) {
