@@ -166,12 +166,14 @@ struct FlowOptions {
   /// Solver of the linear system; the choice does not change the energy that is minimised.
   LinearSolver solver = LinearSolver::Automatic;
   /// Iterative solver: stop when |H d - b| <= solver_tolerance |b| (normal equations, starting
-  /// residual b). Measured against a 1e-13 solve on fandisk, bunny_uniform, max-planck-5k,
-  /// camelhead, spot and amo: 1e-7 leaves every vertex within 4e-5 mean edge lengths of it
-  /// (1e-5 but on fandisk and camelhead; mean 4e-6 or less) with 17-30% fewer iterations than
-  /// 1e-9 (within 3e-7); 1e-6 saves another 10-20% but reaches 4e-4 on fandisk. The flow moves
-  /// vertices by 0.1-3 mean edge lengths and projects them onto the input afterwards.
-  double solver_tolerance = 1e-7;
+  /// residual b). Measured against a 1e-13 solve (largest vertex distance from its position
+  /// there, in mean edge lengths, on fandisk, camelhead, bunny_uniform and spot; the iteration
+  /// counts of bunny_uniform and the 1M-vertex armadillo): 1e-7 within 6e-5 (79 and 174
+  /// iterations), 1e-6 within 2e-4, mean 2e-5 or less (65 and 141), 1e-5 within 4e-3 (52 and
+  /// 112). The flow moves vertices by 0.1-3 mean edge lengths and projects them onto the input
+  /// afterwards, so 1e-6 is far below what shows, at a fifth fewer iterations than 1e-7 (the
+  /// solve is half or more of a large run); docs/benchmarks.md, "Solver tolerance".
+  double solver_tolerance = 1e-6;
   /// Density-weighted centroidal passes after the solves (none by default; DensityRelaxation).
   DensityRelaxation density;
 };

@@ -19,7 +19,7 @@
 // Why these two and how the choice is made (measured on this project's meshes, docs/benchmarks.md):
 // the coupled factorisation costs about n^1.5 (3.1e9 flops at 9k vertices, 1.8e10 at 43k, an
 // estimated 2e12 and 16 GB at 1M), the iteration costs about n, and the iteration count stays
-// between 80 and 300 on smooth meshes of any size at the default tolerance 1e-7 (bunny 9k: 80,
+// between 80 and 300 on smooth meshes of any size at the tolerance 1e-7 (bunny 9k: 80,
 // amo 90k: 291; 98 and 416 at 1e-9) but reaches 900-1,100 where large flat regions leave
 // tangential motion to the bi-Laplacian of F_smo and the tiny pull (fandisk). Preconditioners
 // built on decoupled n x n factorisations (x, y, z, or per-vertex frames) and their two-level
@@ -79,8 +79,12 @@ constexpr Index kFlatRegionForMultilevel = 500;
 // about 120 remaining iterations. Measured after 30 iterations (estimate; actual count):
 // bunny_uniform 67; 79, horse-48k 89; 93, rocker-arm 91; 90, armadillo-43k 95; 129 stay;
 // max-planck-5k 111; 146, fertility 113; 140, spot 121; 222, camelhead 149; 568 switch.
+// The estimates above are at the tolerance they were calibrated at, kSwitchPredictedAt; the
+// rule predicts at it whatever the solve's tolerance, so the path depends on the mesh and the
+// weights only (the first kProbeIterations iterates do not depend on the tolerance).
 constexpr int kProbeIterations = 30;
 constexpr double kSwitchAbovePredicted = 105;
+constexpr double kSwitchPredictedAt = 1e-7;
 // Without a fallback (the factorisation would not fit) the iteration stops at this many
 // times the budget.
 constexpr int kIterationCapFactor = 10;
@@ -297,7 +301,7 @@ Vertices FlowSystemSolver::solve(const FlowFrame& frame, FlowFrame* release, con
     if (s.kind == LinearSolver::Automatic && !multilevel) {
       // Block-Jacobi first; if the first iterations predict a long run, switch.
       result = run_reporting(cg, std::min(kProbeIterations, budget), s.tolerance, s.progress_phase, done);
-      if (!result.converged && cg.predicted_iterations(s.tolerance) > kSwitchAbovePredicted) {
+      if (!result.converged && cg.predicted_iterations(kSwitchPredictedAt) > kSwitchAbovePredicted) {
         report.seconds_solve += seconds_since(start);
         start = Clock::now();
         multilevel = make_multilevel(terms);

@@ -20,7 +20,7 @@ class FlowSystemSolver {
  public:
   /// `fixed` marks the vertices held at frame.P; `kind` and `tolerance` as in FlowOptions.
   FlowSystemSolver(const Topology& topology, std::vector<char> fixed, LinearSolver kind = LinearSolver::Automatic,
-                   double tolerance = 1e-7);
+                   double tolerance = FlowOptions{}.solver_tolerance);
   ~FlowSystemSolver();
   FlowSystemSolver(const FlowSystemSolver&) = delete;
   FlowSystemSolver& operator=(const FlowSystemSolver&) = delete;
