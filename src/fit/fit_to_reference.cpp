@@ -20,6 +20,16 @@
 #include <string>
 
 namespace vertexflow {
+
+std::uint64_t fit_sample_seed(std::uint64_t seed) {
+  // SplitMix64's output function (Steele, Lea, Flood 2014) on the seed with a tag: well mixed,
+  // so no small seed a user gives compare or a report lands on the fit's stream.
+  std::uint64_t z = (seed ^ 0x6669745f73616d70ULL) + 0x9e3779b97f4a7c15ULL;  // tag: "fit_samp"
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
 namespace {
 
 // The data rows of one round, first direction: the reference's samples at their foot points on
@@ -90,7 +100,7 @@ FitResult fit_to_reference(const Vertices& V, const Faces& F, const ReferenceSur
                          SamplingOptions sampling;
                          sampling.samples =
                              static_cast<Index>(std::ceil(options.samples_per_vertex * static_cast<double>(n)));
-                         sampling.seed = options.seed;
+                         sampling.seed = fit_sample_seed(options.seed);
                          sampling.vertices = false;
                          sampling.edge_midpoints = false;
                          samples_pointer = &reference.samples(sampling).points;

@@ -13,8 +13,11 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <iostream>
+#include <vector>
 
 namespace vertexflow {
 namespace {
@@ -94,6 +97,45 @@ TEST(FitToReference, BunnyUniformAgainstTheDenseBunny) {
   EXPECT_LE(out.hausdorff, in.hausdorff);
   EXPECT_GE(triangle_quality(result.V, coarse.F).minCoeff(), 0.25);
   EXPECT_TRUE(result.report.converged);
+}
+
+// The fit draws its samples of the reference from a stream of its own: with the same seed as a
+// measurement (both default to 1) it used to draw exactly the measurement's first points, so the
+// result was scored partly on the points it was fitted to.
+TEST(FitToReference, SamplesTheReferenceApartFromTheMeasurements) {
+  for (const std::uint64_t seed : {0ULL, 1ULL, 2ULL, 42ULL}) {
+    EXPECT_NE(fit_sample_seed(seed), seed);
+    for (const std::uint64_t other : {0ULL, 1ULL, 2ULL, 3ULL, 42ULL}) EXPECT_NE(fit_sample_seed(seed), other);
+  }
+  EXPECT_NE(fit_sample_seed(1), fit_sample_seed(2));
+  // The points themselves: the fit's 10 per vertex of bunny_uniform against compare's 200,000,
+  // both at seed 1, on bunny.off: no point in common (on one stream: all 89,040 of the fit's).
+  const Mesh dense = read_mesh(test::data_path("bunny.off"));
+  const Index fit_count = 10 * 8904;
+  SamplingOptions fit_like, measurement;
+  fit_like.samples = fit_count;
+  fit_like.seed = fit_sample_seed(FitOptions{}.seed);
+  fit_like.vertices = fit_like.edge_midpoints = false;
+  measurement.vertices = measurement.edge_midpoints = false;
+  const Vertices a = sample_surface(dense.V, dense.F, fit_like).points;
+  const Vertices b = sample_surface(dense.V, dense.F, measurement).points;
+  ASSERT_EQ(a.rows(), fit_count);
+  // The samples come sorted by face, so compare as sets.
+  std::vector<std::array<double, 3>> measured;
+  for (Index i = 0; i < b.rows(); ++i) measured.push_back({b(i, 0), b(i, 1), b(i, 2)});
+  std::sort(measured.begin(), measured.end());
+  Index shared = 0;
+  for (Index i = 0; i < fit_count; ++i)
+    shared += std::binary_search(measured.begin(), measured.end(), std::array<double, 3>{a(i, 0), a(i, 1), a(i, 2)});
+  EXPECT_EQ(shared, 0);
+  // What the shared stream gave: the fit's points among the measurement's.
+  fit_like.seed = measurement.seed;
+  const Vertices same_stream = sample_surface(dense.V, dense.F, fit_like).points;
+  Index shared_before = 0;
+  for (Index i = 0; i < fit_count; ++i)
+    shared_before += std::binary_search(measured.begin(), measured.end(),
+                                        std::array<double, 3>{same_stream(i, 0), same_stream(i, 1), same_stream(i, 2)});
+  EXPECT_EQ(shared_before, fit_count);
 }
 
 // An open mesh: the boundary stays bit for bit (fix_boundary), pinned vertices too, and with
