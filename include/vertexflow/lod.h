@@ -67,7 +67,8 @@ struct LodOptions {
   /// remesh, and the fit keeps gaining after FitOptions's 5% (which stops it after 2 rounds).
   /// Measured on bunny.off's levels 50-2% against CGAL's QEM alone (bench/lod_peers): mean
   /// distance -13.2% with 5% and 10 rounds, -16.1% with 0.5% and 30 rounds (the chain 1.6x
-  /// slower), -20.1% with 0.1% and 60 rounds (5x slower).
+  /// slower), -20.1% with 0.1% and 60 rounds (5x slower); measured while the fit's samples were
+  /// the measurement's first points (fit.h, FitOptions::seed), so each about a point too good.
   FitOptions fit = [] {
     FitOptions f;
     f.tolerance = 0.005;
