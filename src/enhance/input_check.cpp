@@ -41,6 +41,9 @@ InputCheck check_input(const Vertices& V, const Faces& F, const InputCheckOption
 
   // Unit normals; faces without area get none, and their edges are left out.
   const Index m = F.rows();
+  const auto distinct_corners = [&F](Index f) {
+    return F(f, 0) != F(f, 1) && F(f, 1) != F(f, 2) && F(f, 2) != F(f, 0);
+  };
   std::vector<Eigen::Vector3d> normal(static_cast<std::size_t>(m));
   std::vector<char> has_normal(static_cast<std::size_t>(m), 0);
   for (Index f = 0; f < m; ++f) {
@@ -48,7 +51,7 @@ InputCheck check_input(const Vertices& V, const Faces& F, const InputCheckOption
                           r = V.row(F(f, 2)).transpose();
     const Eigen::Vector3d n = (q - p).cross(r - p);
     const double length = n.norm();
-    if (length > 0 && std::isfinite(length) && F(f, 0) != F(f, 1) && F(f, 1) != F(f, 2) && F(f, 2) != F(f, 0)) {
+    if (length > 0 && std::isfinite(length) && distinct_corners(f)) {
       normal[static_cast<std::size_t>(f)] = n / length;
       has_normal[static_cast<std::size_t>(f)] = 1;
     }
@@ -58,7 +61,7 @@ InputCheck check_input(const Vertices& V, const Faces& F, const InputCheckOption
   std::vector<EdgeSide> sides;
   sides.reserve(static_cast<std::size_t>(3 * m));
   for (Index f = 0; f < m; ++f)
-    if (F(f, 0) != F(f, 1) && F(f, 1) != F(f, 2) && F(f, 2) != F(f, 0))
+    if (distinct_corners(f))
       for (int k = 0; k < 3; ++k) {
         const Index u = F(f, k), w = F(f, (k + 1) % 3);
         sides.push_back({std::min(u, w), std::max(u, w), f});
