@@ -263,7 +263,7 @@ Vertices FlowSystemSolver::solve(const FlowFrame& frame, const EnergyWeights& we
   return solve(frame, nullptr, weights, report);
 }
 
-Vertices FlowSystemSolver::solve(FlowFrame&& frame, const EnergyWeights& weights, FlowReport& report) {
+Vertices FlowSystemSolver::solve_releasing(FlowFrame& frame, const EnergyWeights& weights, FlowReport& report) {
   return solve(frame, &frame, weights, report);
 }
 
@@ -332,7 +332,7 @@ Vertices FlowSystemSolver::solve(const FlowFrame& frame, FlowFrame* release, con
     }
     report.seconds_solve += seconds_since(start);
     report.solver_iterations = cg.total_iterations();
-    if (!direct) d = cg.solution();
+    if (!direct) d = cg.take_solution();
     used = direct ? LinearSolver::Direct : multilevel ? LinearSolver::Multilevel : LinearSolver::Iterative;
   }
   if (direct && m > 0) d = s.factor_and_solve(terms, b, report);

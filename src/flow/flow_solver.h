@@ -31,8 +31,9 @@ class FlowSystemSolver {
   /// factorisation fails.
   Vertices solve(const FlowFrame& frame, const EnergyWeights& weights, FlowReport& report);
   /// The same, releasing the frame's curvature and sliver blocks once the system is assembled
-  /// (168 bytes per vertex that the solve, the flow's longest phase, does not need).
-  Vertices solve(FlowFrame&& frame, const EnergyWeights& weights, FlowReport& report);
+  /// (168 bytes per vertex that the solve, the flow's longest phase, does not need); the
+  /// frame's P and d stay.
+  Vertices solve_releasing(FlowFrame& frame, const EnergyWeights& weights, FlowReport& report);
 
   /// The phase name under which the iterations report their progress (progress.h): the fall of
   /// the relative residual towards the tolerance, on a log scale, every few iterations. The

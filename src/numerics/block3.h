@@ -25,24 +25,34 @@ inline Eigen::Map<const Eigen::Vector3d> block_at(const BlockVector& v, Index i)
 }
 
 /// A symmetric 3x3 matrix stored as its upper triangle: the iterations that use these are
-/// bound by memory traffic, so 48 bytes instead of 72 matter.
-struct Sym3 {
-  double xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+/// bound by memory traffic, so 48 bytes instead of 72 matter. Products and full() are in
+/// double whatever the storage: `Sym3f` (24 bytes) rounds the entries once when it is made,
+/// so the operator it builds is still exactly symmetric, only of slightly rounded factors.
+template <class Scalar>
+struct BasicSym3 {
+  Scalar xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
 
-  Sym3() = default;
-  explicit Sym3(const Eigen::Matrix3d& m)
-      : xx(m(0, 0)), xy(m(0, 1)), xz(m(0, 2)), yy(m(1, 1)), yz(m(1, 2)), zz(m(2, 2)) {}
+  BasicSym3() = default;
+  explicit BasicSym3(const Eigen::Matrix3d& m)
+      : xx(static_cast<Scalar>(m(0, 0))),
+        xy(static_cast<Scalar>(m(0, 1))),
+        xz(static_cast<Scalar>(m(0, 2))),
+        yy(static_cast<Scalar>(m(1, 1))),
+        yz(static_cast<Scalar>(m(1, 2))),
+        zz(static_cast<Scalar>(m(2, 2))) {}
   [[nodiscard]] Eigen::Matrix3d full() const {
     Eigen::Matrix3d m;
     m << xx, xy, xz, xy, yy, yz, xz, yz, zz;
     return m;
   }
-  [[nodiscard]] double trace() const { return xx + yy + zz; }
+  [[nodiscard]] double trace() const { return double(xx) + double(yy) + double(zz); }
   [[nodiscard]] Eigen::Vector3d operator*(const Eigen::Vector3d& v) const {
-    return {xx * v.x() + xy * v.y() + xz * v.z(), xy * v.x() + yy * v.y() + yz * v.z(),
-            xz * v.x() + yz * v.y() + zz * v.z()};
+    const double a = xx, b = xy, c = xz, d = yy, e = yz, f = zz;
+    return {a * v.x() + b * v.y() + c * v.z(), b * v.x() + d * v.y() + e * v.z(), c * v.x() + e * v.y() + f * v.z()};
   }
 };
+using Sym3 = BasicSym3<double>;
+using Sym3f = BasicSym3<float>;
 
 /// a . b, summed in chunks of 8192 entries in order (deterministic_sum), so that its rounding
 /// does not depend on the threads.

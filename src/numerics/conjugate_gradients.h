@@ -12,6 +12,7 @@
 #include "numerics/block3.h"
 
 #include <optional>
+#include <utility>
 #include <vector>
 
 namespace vertexflow {
@@ -66,6 +67,9 @@ class ConjugateGradients {
   void use_correction(PreconditionerCorrection* correction);
 
   [[nodiscard]] const BlockVector& solution() const { return d_; }
+  /// The solution moved out, without a copy beside the iteration's vectors (whose moment is
+  /// the flow's peak memory); the iteration cannot continue after it.
+  [[nodiscard]] BlockVector take_solution() { return std::move(d_); }
   [[nodiscard]] int total_iterations() const { return total_iterations_; }
   /// |r| / |b| of the current iterate (0 for b = 0).
   [[nodiscard]] double relative_residual() const { return b_norm_ > 0 ? r_norm_ / b_norm_ : 0.0; }
