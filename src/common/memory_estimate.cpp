@@ -13,12 +13,13 @@
 namespace vertexflow {
 namespace {
 
-// Measured peaks per vertex (docs/benchmarks.md, "Memory by phase" and "After the first
-// changes"), rounded up: the flow's multilevel path 1,460 B (arm1m, arm10m), the block-Jacobi
-// path 1,100 B; with --report 1,734 B (arm1m, the metrics' peak). A reference vertex costs its
-// distance tree, curvature and copies.
-constexpr double kFlowBytesPerVertex = 1600;
-constexpr double kReportBytesPerVertex = 1800;
+// Measured peaks per vertex (docs/benchmarks.md, "Float factors and two fewer vertex copies"),
+// rounded up: the flow's multilevel path 1,289 B (arm1m), 1,108 B with --report (arm10m); the
+// block-Jacobi path 943 B (arm1m). The report's metrics now peak below the flow (870 against
+// 1,162 MiB at 1M, "The report's metrics after the issue 29 change"), so a report adds nothing.
+// A reference vertex costs its distance tree, curvature and copies.
+constexpr double kFlowBytesPerVertex = 1400;
+constexpr double kReportBytesPerVertex = 1400;
 constexpr double kReferenceBytesPerVertex = 900;
 
 // A "Key:   N kB" line of a /proc file, in bytes.

@@ -60,7 +60,7 @@ TEST(CliMemoryLimit, EveryRunEndsWithSuccessOrOneErrorLine) {
 
 // Before a run that would not fit, the CLI estimates its peak from the mesh size and stops with
 // one line naming the file, the estimate and what is available (issue 29), instead of failing
-// an allocation halfway or being killed. 655,362 vertices need about 1 GiB by the estimate
+// an allocation halfway or being killed. 655,362 vertices need about 0.85 GiB by the estimate
 // (docs/benchmarks.md); under a 900 MB address-space limit the process has about 0.4 GiB left
 // once the mesh is read, while the same limit runs bunny_uniform (8.9k vertices).
 TEST(CliMemoryLimit, ARunThatWouldNotFitIsRefusedBeforeItStartsWithOneLine) {
