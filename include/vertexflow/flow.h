@@ -233,6 +233,12 @@ FlowResult vertex_flow(const Vertices& V, const Faces& F, const FlowOptions& opt
 /// topology was built for another vertex or face count.
 FlowResult vertex_flow(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options = {});
 
+/// The same, taking the topology: once the set-up has used them, the flow frees its face edges,
+/// face adjacency, edge face counts, components and manifold flags (73 bytes per vertex that the
+/// solve, the flow's peak, does not need), and leaves those fields empty. vertex_flow(V, F,
+/// options) goes through this one.
+FlowResult vertex_flow(const Vertices& V, const Faces& F, Topology&& topology, const FlowOptions& options = {});
+
 /// The paper's flow with the true surface S known (issue 16): section 4.1 measures F_sd against S
 /// and uses the input only "since S is usually unavailable". Here every solve takes from S, at
 /// each vertex's closest point on it (its foot point), the anchor p_i and frame of F_sd and the

@@ -145,13 +145,16 @@ struct MethodRun {
   nlohmann::json report;
 };
 
+// `topology`: as enhance_clean's.
 MethodRun run_flow(const Mesh& mesh, const ReferenceSurface* reference, const FlowOptions& options,
-                   const EnhanceCallbacks& callbacks, const Warnings& warn, const Topology* topology) {
+                   const EnhanceCallbacks& callbacks, const Warnings& warn, Topology* topology,
+                   bool topology_is_spare) {
   const auto start = Clock::now();
   FlowResult result = reference
                           ? vertex_flow_on_reference(mesh.V, mesh.F, reference->vertices(), reference->faces(), options)
-                      : topology ? vertex_flow(mesh.V, mesh.F, *topology, options)
-                                 : vertex_flow(mesh.V, mesh.F, build_topology(mesh.F, mesh.num_vertices()), options);
+                      : !topology ? vertex_flow(mesh.V, mesh.F, build_topology(mesh.F, mesh.num_vertices()), options)
+                      : topology_is_spare ? vertex_flow(mesh.V, mesh.F, std::move(*topology), options)
+                                          : vertex_flow(mesh.V, mesh.F, std::as_const(*topology), options);
   const double flow_seconds = seconds_since(start);  // before the phase lines, which a terminal may slow
   const FlowReport& r = result.report;
   tell(callbacks.phase, fmt::format("curvature {:.3f} s, assembly {:.3f} s, solve {:.3f} s, projection {:.3f} s, "
@@ -509,9 +512,11 @@ const char* progress_phase(EnhanceMode mode) {
 
 // The engine on a mesh whose faces all have three distinct vertices, positive area and no
 // duplicate, and whose vertices all have faces; attributes are left to enhance(). `topology`, when
-// given, is the mesh's (build_topology), for the flow.
+// given, is the mesh's (build_topology), for the flow; if `topology_is_spare` the caller needs it
+// no more, and the flow frees the parts only its set-up reads (flow.h).
 EnhanceResult enhance_clean(const Mesh& mesh, const ReferenceSurface* reference, const EnhanceOptions& options,
-                            const EnhanceCallbacks& callbacks, const Topology* topology = nullptr) {
+                            const EnhanceCallbacks& callbacks, Topology* topology = nullptr,
+                            bool topology_is_spare = false) {
   // Trees over the reference's faces this run builds (its own, or any step's copy): one is the
   // promise of reference_surface.h, the flow on S's own tree a second (flow.h).
   const std::uint64_t trees_before = reference ? distance_trees_built(reference->faces().rows()) : 0;
@@ -565,7 +570,7 @@ EnhanceResult enhance_clean(const Mesh& mesh, const ReferenceSurface* reference,
       run = run_unsharp(mesh, effective_unsharp_options(options), warn);
       break;
     case EnhanceMode::ReferenceFlow:
-      run = run_flow(mesh, reference, flow, callbacks, warn, nullptr);
+      run = run_flow(mesh, reference, flow, callbacks, warn, nullptr, false);
       break;
     case EnhanceMode::Flow: {
       // The flow and its density passes slide the vertices over the input's facets: an input
@@ -579,7 +584,7 @@ EnhanceResult enhance_clean(const Mesh& mesh, const ReferenceSurface* reference,
         run.report["options"] = flow;
         run.V = mesh.V;
       } else {
-        run = run_flow(mesh, nullptr, flow, callbacks, warn, topology);
+        run = run_flow(mesh, nullptr, flow, callbacks, warn, topology, topology_is_spare);
       }
       run.report["hold"] = hold_json(hold, options.assume_on_surface);
       break;
@@ -762,7 +767,7 @@ EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const
     // The flow takes the topology; the other modes build what they need, so it goes now.
     if (enhance_mode(options, reference != nullptr) != EnhanceMode::Flow) topology.reset();
     const ProgressPart part("", kPrepared, method_ends);
-    return enhance_clean(mesh, reference, options, callbacks, topology ? &*topology : nullptr);
+    return enhance_clean(mesh, reference, options, callbacks, topology ? &*topology : nullptr, true);
   }
 
   // Chart boundaries (seams, material boundaries) are creases for the flow and never flipped.

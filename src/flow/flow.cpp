@@ -60,8 +60,9 @@ struct SurfaceView {
   const Faces& F;
 };
 
+// `releasable`, when given, is `topology` itself, which the flow may trim (release_set_up_parts).
 FlowResult check_then(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options,
-                      const SurfaceView* reference);
+                      const SurfaceView* reference, Topology* releasable);
 
 // Flows the manifold split of a non-manifold or inconsistently oriented mesh (flow.h), on the
 // input or on the reference: the copies of held vertices are pinned, so every input vertex has
@@ -91,7 +92,8 @@ FlowResult flow_on_manifold_split(const Vertices& V, const Faces& F, const Topol
   }
   for (Index v = 0; v < static_cast<Index>(V.rows()); ++v)
     if (split.held[static_cast<std::size_t>(v)]) pin_copies(v);
-  FlowResult on_copies = check_then(split.V, split.F, build_topology(split.F, split.V.rows()), on_split, reference);
+  Topology split_topology = build_topology(split.F, split.V.rows());
+  FlowResult on_copies = check_then(split.V, split.F, split_topology, on_split, reference, &split_topology);
   FlowResult result;
   result.report = on_copies.report;
   result.V = V;
@@ -136,8 +138,21 @@ constexpr double kSolveStarts = 0.05, kProjectionStarts = 0.85, kGuardStarts = 0
 
 // The rounds of vertex_flow on a manifold, oriented mesh with valid options: on the input, or
 // with frames, curvature and projection from the reference S (vertex_flow_on_reference).
+// What the flow reads of the topology after its set-up: the edges, rings, vertex faces and
+// boundary flags (curvature, flow terms, projection, guard, density passes). The rest served
+// prepare_flow's features only: 73 bytes per vertex (face edges 24, face adjacency 24, edge
+// face counts 12, components 12, manifold flags 1) that the solve, the peak, need not hold.
+void release_set_up_parts(Topology& topology) {
+  topology.face_edges.resize(0, 3);
+  topology.face_adjacency.resize(0, 3);
+  std::vector<Index>().swap(topology.edge_face_count);
+  std::vector<Index>().swap(topology.vertex_component);
+  std::vector<Index>().swap(topology.face_component);
+  std::vector<std::uint8_t>().swap(topology.is_manifold_vertex);
+}
+
 FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options,
-                       const SurfaceView* reference) {
+                       const SurfaceView* reference, Topology* releasable) {
   const Index n = static_cast<Index>(V.rows());
   FlowResult result;
   FlowReport& report = result.report;
@@ -153,6 +168,7 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
   progress(reference ? "flow set-up, reference surface" : "flow set-up", 0, kSetUpUnits);
 
   const FlowSetup setup = prepare_flow(V, F, topology, options);
+  if (releasable) release_set_up_parts(*releasable);
   std::optional<ReferenceSurface> surface;
   if (reference) {  // S in the flow's normalised units
     const Vertices VS = (reference->V.rowwise() - setup.centroid) / setup.scale;
@@ -293,7 +309,7 @@ namespace {
 // vertex_flow's checks, then the rounds (on the manifold split of a non-manifold mesh when
 // options allow), on the input or on the reference.
 FlowResult check_then(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options,
-                      const SurfaceView* reference) {
+                      const SurfaceView* reference, Topology* releasable) {
   const Index n = static_cast<Index>(V.rows());
   validate_flow_options(options, n);
   if (n == 0 || F.rows() == 0) throw std::invalid_argument("vertex flow: the mesh is empty");
@@ -313,13 +329,17 @@ FlowResult check_then(const Vertices& V, const Faces& F, const Topology& topolog
                                                          : describe_non_manifold(topology)));
     return flow_on_manifold_split(V, F, topology, options, reference);
   }
-  return flow_rounds(V, F, topology, options, reference);
+  return flow_rounds(V, F, topology, options, reference, releasable);
 }
 
 }  // namespace
 
 FlowResult vertex_flow(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options) {
-  return check_then(V, F, topology, options, nullptr);
+  return check_then(V, F, topology, options, nullptr, nullptr);
+}
+
+FlowResult vertex_flow(const Vertices& V, const Faces& F, Topology&& topology, const FlowOptions& options) {
+  return check_then(V, F, topology, options, nullptr, &topology);
 }
 
 FlowResult vertex_flow_on_reference(const Vertices& V, const Faces& F, const Vertices& VS, const Faces& FS,
@@ -329,9 +349,9 @@ FlowResult vertex_flow_on_reference(const Vertices& V, const Faces& F, const Ver
   if (!VS.allFinite())
     throw std::invalid_argument("vertex flow on a reference: a vertex of the reference has a non-finite coordinate");
   if (V.rows() == 0 || F.rows() == 0) throw std::invalid_argument("vertex flow: the mesh is empty");
-  const Topology topology = build_topology(F, static_cast<Index>(V.rows()));
+  Topology topology = build_topology(F, static_cast<Index>(V.rows()));
   const SurfaceView reference{VS, FS};
-  return check_then(V, F, topology, options, &reference);
+  return check_then(V, F, topology, options, &reference, &topology);
 }
 
 }  // namespace vertexflow
