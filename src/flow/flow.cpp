@@ -136,8 +136,6 @@ Eigen::VectorXd checked_density(const Curvature& c, const DensityRelaxation& opt
 constexpr double kSetUpUnits = 0.1, kDensityPassUnits = 0.15;
 constexpr double kSolveStarts = 0.05, kProjectionStarts = 0.85, kGuardStarts = 0.93;
 
-// The rounds of vertex_flow on a manifold, oriented mesh with valid options: on the input, or
-// with frames, curvature and projection from the reference S (vertex_flow_on_reference).
 // What the flow reads of the topology after its set-up: the edges, rings, vertex faces and
 // boundary flags (curvature, flow terms, projection, guard, density passes). The rest served
 // prepare_flow's features only: 73 bytes per vertex (face edges 24, face adjacency 24, edge
@@ -151,6 +149,8 @@ void release_set_up_parts(Topology& topology) {
   std::vector<std::uint8_t>().swap(topology.is_manifold_vertex);
 }
 
+// The rounds of vertex_flow on a manifold, oriented mesh with valid options: on the input, or
+// with frames, curvature and projection from the reference S (vertex_flow_on_reference).
 FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options,
                        const SurfaceView* reference, Topology* releasable) {
   const Index n = static_cast<Index>(V.rows());
