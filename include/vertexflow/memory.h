@@ -22,10 +22,11 @@ class InsufficientMemoryError : public std::runtime_error {
 };
 
 /// The whole process's peak resident memory for `enhance` on a mesh of `vertices` (bytes), from
-/// the measured peaks per vertex of docs/benchmarks.md ("Memory by phase"), rounded up: the
-/// flow's multilevel path (the larger), the report's metrics when `with_report`, and the
-/// reference's trees and curvature per reference vertex (`reference_vertices`, 0 for none).
-/// Never throws.
+/// the measured peaks per vertex of docs/benchmarks.md ("Float factors and two fewer vertex
+/// copies"), rounded up: the flow's multilevel path (the larger), plus the reference's trees and
+/// curvature per reference vertex (`reference_vertices`, 0 for none). The report's metrics peak
+/// below the flow, so `with_report` does not change the estimate (require_memory_for_enhance
+/// names it in its message). Never throws.
 std::uint64_t estimated_enhance_peak_bytes(Index vertices, bool with_report, Index reference_vertices);
 
 /// What this process can still allocate (bytes), and which limit says so.

@@ -16,10 +16,9 @@ namespace {
 // Measured peaks per vertex (docs/benchmarks.md, "Float factors and two fewer vertex copies"),
 // rounded up: the flow's multilevel path 1,289 B (arm1m), 1,108 B with --report (arm10m); the
 // block-Jacobi path 943 B (arm1m). The report's metrics now peak below the flow (870 against
-// 1,162 MiB at 1M, "The report's metrics after the issue 29 change"), so a report adds nothing.
-// A reference vertex costs its distance tree, curvature and copies.
-constexpr double kFlowBytesPerVertex = 1400;
-constexpr double kReportBytesPerVertex = 1400;
+// 1,162 MiB at 1M, "The report's metrics after the issue 29 change"), so a report adds nothing
+// and one figure serves both. A reference vertex costs its distance tree, curvature and copies.
+constexpr double kBytesPerVertex = 1400;
 constexpr double kReferenceBytesPerVertex = 900;
 
 // A "Key:   N kB" line of a /proc file, in bytes.
@@ -52,9 +51,8 @@ double gib(std::uint64_t bytes) {
 
 }  // namespace
 
-std::uint64_t estimated_enhance_peak_bytes(Index vertices, bool with_report, Index reference_vertices) {
-  const double per_vertex = with_report ? kReportBytesPerVertex : kFlowBytesPerVertex;
-  return static_cast<std::uint64_t>(per_vertex * vertices + kReferenceBytesPerVertex * reference_vertices);
+std::uint64_t estimated_enhance_peak_bytes(Index vertices, bool /*with_report*/, Index reference_vertices) {
+  return static_cast<std::uint64_t>(kBytesPerVertex * vertices + kReferenceBytesPerVertex * reference_vertices);
 }
 
 std::optional<AvailableMemory> available_memory() {

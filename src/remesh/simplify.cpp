@@ -56,9 +56,9 @@ SimplifyResult simplify(const Vertices& V, const Faces& F, const SimplifyOptions
     // A closed mesh has nothing to constrain: the unconstrained call collapses the same edges
     // to the same places, and skips Constrained_placement's walk around both ends of every
     // edge costed (15% of the run on a closed 1M-vertex mesh, measured with perf).
-    const bool has_boundary =
-        std::any_of(mesh.edges().begin(), mesh.edges().end(), [&](auto e) { return mesh.is_border(e); });
-    if (options.keep_boundary && has_boundary) {
+    const bool constrain_boundary = options.keep_boundary && std::any_of(mesh.edges().begin(), mesh.edges().end(),
+                                                                         [&](auto e) { return mesh.is_border(e); });
+    if (constrain_boundary) {
       // Boundary edges are constrained: never collapsed, and Constrained_placement puts any
       // collapse that touches a boundary vertex onto that vertex, so the loops stay exact.
       auto on_boundary = mesh.add_property_map<SurfaceMesh::Edge_index, bool>("e:vertexflow_boundary", false).first;
