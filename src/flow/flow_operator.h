@@ -11,7 +11,7 @@ namespace vertexflow {
 
 /// H x without forming H: a pointwise pass (K x), then two passes over the one-rings: q = P G x
 /// and r = S (L x - R) (the weighted rows of F_tan and F_smo) with K q; then G q + L^T r + D x.
-/// The per-vertex factors are stored as symmetric 3x3 (48 bytes) and the dot product x . y that
+/// The per-vertex factors are stored as symmetric 3x3 (Sym3f) and the dot product x . y that
 /// conjugate gradients need is summed in the last pass: about a third fewer bytes per iteration
 /// than full 3x3 blocks and separate passes, while applying K once per vertex and pass (applying
 /// it per neighbour instead, with no K x array, saved more bytes but cost more time: the
@@ -21,7 +21,7 @@ class FlowOperator : public BlockOperator {
   explicit FlowOperator(const FlowTerms& terms);
 
   double apply(const BlockVector& x, BlockVector& y) override;
-  double apply_updated(BlockVector& p, const BlockVector& z, double beta, BlockVector& y) override;
+  double apply_updated(BlockVector& p, const PreconditionedResidual& z, double beta, BlockVector& y) override;
 
   /// b = -(G P G x + L^T S (L x - R)) at x = the frame's positions (local order): the negative
   /// half-gradient of the energy at d = 0, the normal equations' right-hand side (D drops out).
@@ -32,9 +32,8 @@ class FlowOperator : public BlockOperator {
   double passes(const BlockVector& x, BlockVector& y, bool with_d, bool with_rest, First&& first);
 
   const FlowTerms& t_;
-  std::vector<double> xkx_;  // per vertex: x, K x
-  std::vector<double> qkr_;  // per vertex: q, K q, r / degree
-  BlockVector r_;
+  std::vector<double> kx_;   // per vertex: K x
+  std::vector<double> qkr_;  // per vertex: q, K q, r
 };
 
 /// The upper half (diagonal included) of the Galerkin matrix Phi^T H Phi, summed vertex by

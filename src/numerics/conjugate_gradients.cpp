@@ -17,14 +17,19 @@ ConjugateGradients::ConjugateGradients(BlockOperator& op, std::vector<Sym3> bloc
       blocks_(static_cast<Index>(inverse_.size())) {
   d_.setZero(b.size());
   r_ = b;
-  z_.resize(b.size());
   hp_.resize(b.size());
+  p_.resize(b.size());
+  if (correction_) z_.resize(b.size());
   rz_ = sum_over_vertices(blocks_, 0.0, [&](Index i) {
-    block_at(z_, i) = inverse_[static_cast<std::size_t>(i)] * block_at(r_, i);
-    return block_at(r_, i).dot(block_at(z_, i));
+    const Eigen::Vector3d z = inverse_[static_cast<std::size_t>(i)] * block_at(r_, i);
+    if (correction_) block_at(z_, i) = z;
+    block_at(p_, i) = z;
+    return block_at(r_, i).dot(z);
   });
-  if (correction_) rz_ = correction_->add_to(r_, z_);
-  p_ = z_;
+  if (correction_) {
+    rz_ = correction_->add_to(r_, z_);
+    p_ = z_;
+  }
   b_norm_ = std::sqrt(deterministic_dot(b, b));
   r_norm_ = b_norm_;
 }
@@ -38,7 +43,8 @@ IterationResult ConjugateGradients::run(int max_iterations, double tolerance) {
   }
   while (result.iterations < max_iterations) {
     // p = z + beta p is still to be done when a previous iteration computed beta.
-    const double curvature = pending_beta_ ? op_.apply_updated(p_, z_, *pending_beta_, hp_) : op_.apply(p_, hp_);
+    const PreconditionedResidual z = correction_ ? PreconditionedResidual(z_) : PreconditionedResidual(inverse_, r_);
+    const double curvature = pending_beta_ ? op_.apply_updated(p_, z, *pending_beta_, hp_) : op_.apply(p_, hp_);
     pending_beta_.reset();
     if (!(curvature > 0)) break;  // H is positive definite; only rounding at convergence gets here
     const double alpha = rz_ / curvature;
@@ -49,7 +55,7 @@ IterationResult ConjugateGradients::run(int max_iterations, double tolerance) {
       const Eigen::Vector3d r = block_at(r_, i) - alpha * block_at(hp_, i);
       const Eigen::Vector3d z = inverse_[static_cast<std::size_t>(i)] * r;
       block_at(r_, i) = r;
-      block_at(z_, i) = z;
+      if (correction_) block_at(z_, i) = z;
       return Eigen::Vector2d(r.squaredNorm(), r.dot(z));
     });
     r_norm_ = std::sqrt(sums[0]);
@@ -86,6 +92,7 @@ double ConjugateGradients::predicted_iterations(double tolerance) const {
 
 void ConjugateGradients::use_correction(PreconditionerCorrection* correction) {
   correction_ = correction;
+  z_.resize(r_.size());
   parallel_for_index(blocks_,
                      [&](Index i) { block_at(z_, i) = inverse_[static_cast<std::size_t>(i)] * block_at(r_, i); });
   rz_ = correction_->add_to(r_, z_);
