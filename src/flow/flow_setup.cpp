@@ -45,6 +45,12 @@ std::vector<Eigen::Matrix3d> sliver_stiffness(const Vertices& X, const Faces& F,
   return stiffness;
 }
 
+// The normalisation (flow.h, "Scale and rigid motion"), in one place so that restoring the input
+// gives its bytes.
+Vertices normalised(const Vertices& V, const FlowSetup& setup) {
+  return (V.rowwise() - setup.centroid) / setup.scale;
+}
+
 }  // namespace
 
 FlowSetup prepare_flow(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options) {
@@ -68,13 +74,24 @@ FlowSetup prepare_flow(const Vertices& V, const Faces& F, const Topology& topolo
   setup.centroid = V.colwise().mean();
   setup.mean_edge_length = mean_edge_length(V, topology);
   setup.scale = setup.mean_edge_length > 0 ? setup.mean_edge_length : 1.0;
-  setup.input = (V.rowwise() - setup.centroid) / setup.scale;
+  setup.input = normalised(V, setup);
   if (options.guard.min_quality > 0 && options.weights.sliver > 0) {
     const Eigen::VectorXd quality = triangle_quality(setup.input, F);
     for (Index f = 0; f < static_cast<Index>(F.rows()); ++f)
       if (quality[f] < options.guard.min_quality) setup.sliver_faces.push_back(f);
   }
   return setup;
+}
+
+void release_during_solve(FlowSetup& setup) {
+  Vertices().swap(setup.input);
+  Vertices().swap(setup.features.vertex_normals);
+}
+
+void restore_after_solve(FlowSetup& setup, const Vertices& V, const Faces& F) {
+  if (setup.input.rows() == 0) setup.input = normalised(V, setup);
+  // detect_features' own normals (features.h).
+  if (setup.features.vertex_normals.rows() == 0) setup.features.vertex_normals = vertex_normals(V, F);
 }
 
 FlowFrame flow_frame(const Vertices& X, const Faces& F, const Topology& topology, const FlowOptions& options,

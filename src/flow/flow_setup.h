@@ -35,6 +35,12 @@ struct FlowSetup {
 /// The preparation of vertex_flow for valid options and a valid mesh.
 FlowSetup prepare_flow(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options);
 
+/// Frees what a solve does not read of `setup` (the normalised input and the features' vertex
+/// normals: 48 bytes per vertex at the solve, the flow's peak); restore_after_solve(setup, V, F)
+/// with prepare_flow's V and F computes them again, bit for bit.
+void release_during_solve(FlowSetup& setup);
+void restore_after_solve(FlowSetup& setup, const Vertices& V, const Faces& F);
+
 /// The frame of one solve at positions X (normalised units): X, its curvature
 /// (options.curvature), the radius d of Eq. 6 at options.d_percentile and F_sliver's
 /// stiffness at X for `sliver_faces` (none if empty).
