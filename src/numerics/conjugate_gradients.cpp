@@ -43,8 +43,10 @@ IterationResult ConjugateGradients::run(int max_iterations, double tolerance) {
   }
   while (result.iterations < max_iterations) {
     // p = z + beta p is still to be done when a previous iteration computed beta.
-    const PreconditionedResidual z = correction_ ? PreconditionedResidual(z_) : PreconditionedResidual(inverse_, r_);
-    const double curvature = pending_beta_ ? op_.apply_updated(p_, z, *pending_beta_, hp_) : op_.apply(p_, hp_);
+    const PreconditionedResidual preconditioned =
+        correction_ ? PreconditionedResidual(z_) : PreconditionedResidual(inverse_, r_);
+    const double curvature =
+        pending_beta_ ? op_.apply_updated(p_, preconditioned, *pending_beta_, hp_) : op_.apply(p_, hp_);
     pending_beta_.reset();
     if (!(curvature > 0)) break;  // H is positive definite; only rounding at convergence gets here
     const double alpha = rz_ / curvature;
