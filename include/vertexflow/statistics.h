@@ -10,4 +10,8 @@ namespace vertexflow {
 /// std::invalid_argument unless 0 <= p <= 100.
 double percentile(std::vector<double> values, double p);
 
+/// percentile(values, p) for each p of `ps`, from one copy of the values (each later rank is
+/// selected among the values above the one before). Throws as percentile does.
+std::vector<double> percentiles(std::vector<double> values, const std::vector<double>& ps);
+
 }  // namespace vertexflow

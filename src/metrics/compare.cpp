@@ -5,6 +5,8 @@
 #include "vertexflow/statistics.h"
 #include "vertexflow/topology.h"
 
+#include "numerics/parallel.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
@@ -49,7 +51,8 @@ void check_curvature(const Mesh& mesh, MeshRole role, const Curvature* curvature
 SurfaceCurvatureAtPoints own_curvature(const Curvature& c) {
   SurfaceCurvatureAtPoints out;
   out.tensors.resize(static_cast<std::size_t>(c.k1.size()));
-  for (Index i = 0; i < c.k1.size(); ++i) out.tensors[static_cast<std::size_t>(i)] = c.absolute_tensor(i);
+  parallel_for_index(static_cast<Index>(c.k1.size()),
+                     [&](Index i) { out.tensors[static_cast<std::size_t>(i)] = c.absolute_tensor(i); });
   out.magnitude = c.absolute_sum();
   return out;
 }
@@ -82,8 +85,8 @@ const char* to_string(MeshRole role) {
 
 MeanCurvaturePercentiles mean_curvature_percentiles(const Curvature& curvature) {
   const Eigen::VectorXd h = curvature.mean().cwiseAbs();
-  const std::vector<double> values(h.data(), h.data() + h.size());
-  return {percentile(values, 5), percentile(values, 50), percentile(values, 95), percentile(values, 99)};
+  const std::vector<double> p = percentiles(std::vector<double>(h.data(), h.data() + h.size()), {5, 50, 95, 99});
+  return {p[0], p[1], p[2], p[3]};
 }
 
 SurfaceCurvatureAtPoints surface_curvature_at(const Vertices& P, const DistanceQuery& surface,
@@ -157,8 +160,17 @@ MeshComparison compare_meshes(const Mesh& result, const Mesh& input, const Mesh*
   std::optional<DistanceQuery> query;
   SurfaceSamples result_samples, input_samples, reference_samples;
   Curvature own_result_curvature, own_input_curvature, own_reference_curvature;
+  // Mesh quality, degenerate and flipped faces (partly serial loops) alongside.
+  const auto quality = [&] {
+    tbb::parallel_invoke([&] { c.quality_input = summarize_quality(triangle_quality(input.V, input.F)); },
+                         [&] { c.quality_result = summarize_quality(triangle_quality(result.V, result.F)); });
+    c.degenerate_faces_input = static_cast<Index>(degenerate_faces(input.V, input.F).size());
+    c.degenerate_faces_result = static_cast<Index>(degenerate_faces(result.V, result.F).size());
+    c.same_connectivity = result.V.rows() == input.V.rows() && result.F.rows() == input.F.rows() && result.F == input.F;
+    if (c.same_connectivity) c.flipped_faces = static_cast<Index>(flipped_faces(input.V, result.V, input.F).size());
+  };
   tbb::parallel_invoke(
-      [&] { query.emplace(input.V, input.F, Borrow{}); },
+      quality, [&] { query.emplace(input.V, input.F, Borrow{}); },
       [&] { result_samples = sample_surface(result.V, result.F, options.sampling); },
       [&] { input_samples = sample_surface(input.V, input.F, options.sampling); },
       [&] {
@@ -224,14 +236,6 @@ MeshComparison compare_meshes(const Mesh& result, const Mesh& input, const Mesh*
   }
   c.abs_mean_curvature_input = mean_curvature_percentiles(input_curvature);
   c.abs_mean_curvature_result = mean_curvature_percentiles(result_curvature);
-
-  // Mesh quality.
-  c.quality_input = summarize_quality(triangle_quality(input.V, input.F));
-  c.quality_result = summarize_quality(triangle_quality(result.V, result.F));
-  c.degenerate_faces_input = static_cast<Index>(degenerate_faces(input.V, input.F).size());
-  c.degenerate_faces_result = static_cast<Index>(degenerate_faces(result.V, result.F).size());
-  c.same_connectivity = result.V.rows() == input.V.rows() && result.F.rows() == input.F.rows() && result.F == input.F;
-  if (c.same_connectivity) c.flipped_faces = static_cast<Index>(flipped_faces(input.V, result.V, input.F).size());
   return c;
 }
 

@@ -2,6 +2,8 @@
 
 #include "vertexflow/statistics.h"
 
+#include "numerics/parallel.h"
+
 #include <algorithm>
 #include <cmath>
 #include <vector>
@@ -17,8 +19,12 @@ double triangle_quality(const Eigen::Vector3d& p0, const Eigen::Vector3d& p1, co
 
 Eigen::VectorXd triangle_quality(const Vertices& V, const Faces& F) {
   Eigen::VectorXd q(F.rows());
-  for (Eigen::Index f = 0; f < F.rows(); ++f)
-    q[f] = triangle_quality(V.row(F(f, 0)).transpose(), V.row(F(f, 1)).transpose(), V.row(F(f, 2)).transpose());
+  parallel_for_index(
+      static_cast<Index>(F.rows()),
+      [&](Index f) {
+        q[f] = triangle_quality(V.row(F(f, 0)).transpose(), V.row(F(f, 1)).transpose(), V.row(F(f, 2)).transpose());
+      },
+      4096, 4096);
   return q;
 }
 

@@ -7,6 +7,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
 namespace vertexflow {
 namespace {
 
@@ -64,6 +68,50 @@ TEST(Percentile, NearestRank) {
   EXPECT_THROW(percentile(values, -0.5), std::invalid_argument);
   EXPECT_THROW(percentile(values, 100.5), std::invalid_argument);
   EXPECT_THROW(percentile(values, std::nan("")), std::invalid_argument);
+}
+
+// Ranks by a parallel sort of (value, index): on many ties, the coefficient a plain average-rank
+// computation gives, bit for bit.
+TEST(Spearman, ManyTiesMatchAPlainComputation) {
+  const Eigen::Index n = 20000;
+  Eigen::VectorXd a(n), b(n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    a[i] = static_cast<double>((i * 7919) % 37);  // 37 values, about 540 ties each
+    b[i] = static_cast<double>((i * 104729) % 1009) - 0.5 * static_cast<double>(i % 3);
+  }
+  const auto plain_ranks = [](const Eigen::VectorXd& x) {
+    std::vector<Eigen::Index> order(static_cast<std::size_t>(x.size()));
+    for (Eigen::Index i = 0; i < x.size(); ++i) order[static_cast<std::size_t>(i)] = i;
+    std::stable_sort(order.begin(), order.end(), [&](Eigen::Index p, Eigen::Index q) { return x[p] < x[q]; });
+    Eigen::VectorXd r(x.size());
+    for (Eigen::Index i = 0; i < x.size();) {
+      Eigen::Index j = i;
+      while (j + 1 < x.size() && x[order[static_cast<std::size_t>(j + 1)]] == x[order[static_cast<std::size_t>(i)]])
+        ++j;
+      for (Eigen::Index k = i; k <= j; ++k)
+        r[order[static_cast<std::size_t>(k)]] = 0.5 * static_cast<double>(i + j) + 1.0;
+      i = j + 1;
+    }
+    return r;
+  };
+  const Eigen::VectorXd ra = plain_ranks(a).array() - (static_cast<double>(n) + 1) / 2;
+  const Eigen::VectorXd rb = plain_ranks(b).array() - (static_cast<double>(n) + 1) / 2;
+  const double expected = ra.dot(rb) / std::sqrt(ra.squaredNorm() * rb.squaredNorm());
+  EXPECT_EQ(spearman_correlation(a, b), expected);
+  EXPECT_NE(expected, 0.0);
+}
+
+// Several percentiles from one copy: each is percentile()'s, in any order of the requests.
+TEST(Percentile, SeveralAtOnceAreEachPercentile) {
+  std::vector<double> values;
+  for (int i = 0; i < 1001; ++i) values.push_back(static_cast<double>((i * 613) % 101));  // with ties
+  const std::vector<double> ps = {95, 5, 50, 99, 50, 0, 100, 21.5};
+  const std::vector<double> got = percentiles(values, ps);
+  ASSERT_EQ(got.size(), ps.size());
+  for (std::size_t k = 0; k < ps.size(); ++k) EXPECT_EQ(got[k], percentile(values, ps[k])) << "p = " << ps[k];
+  EXPECT_EQ(percentiles({}, {5, 95}), (std::vector<double>{0.0, 0.0}));
+  EXPECT_THROW(percentiles(values, {5, 100.5}), std::invalid_argument);
+  EXPECT_THROW(percentiles({}, {-1}), std::invalid_argument);
 }
 
 }  // namespace
