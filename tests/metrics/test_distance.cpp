@@ -8,12 +8,14 @@
 #include "vertexflow/topology.h"
 
 #include <gtest/gtest.h>
+
 #include <tbb/global_control.h>
 
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <random>
+#include <set>
 
 namespace vertexflow {
 namespace {
@@ -173,8 +175,8 @@ TEST(DistanceQuery, ReportsTheMemoryItHolds) {
   }
   const Mesh mesh = test::icosphere(1.0, 3);
   const ReferenceSurface reference(mesh.V, mesh.F);
-  const std::size_t mesh_bytes =
-      static_cast<std::size_t>(mesh.V.size()) * sizeof(double) + static_cast<std::size_t>(mesh.F.size()) * sizeof(Index);
+  const std::size_t mesh_bytes = static_cast<std::size_t>(mesh.V.size()) * sizeof(double) +
+                                 static_cast<std::size_t>(mesh.F.size()) * sizeof(Index);
   EXPECT_EQ(reference.memory_bytes(), mesh_bytes);
   const std::size_t tree_bytes = reference.distance_query().memory_bytes();
   EXPECT_EQ(reference.memory_bytes(), mesh_bytes + tree_bytes);
@@ -304,6 +306,34 @@ TEST(SampleSurface, VerticesAndEdgeMidpointsFollowTheSamples) {
   options.vertices = false;
   options.edge_midpoints = false;
   EXPECT_EQ(sample_surface(mesh.V, mesh.F, options).points.rows(), 100);
+}
+
+// The midpoints of any triangle list: each undirected edge once, in (smaller, larger) vertex
+// order, faces repeating a vertex, repeated faces and edges of three faces included.
+TEST(SampleSurface, EdgeMidpointsOfATriangleSoup) {
+  Mesh soup;
+  soup.V.resize(6, 3);
+  soup.V << 0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 0, 0, 1, 2, 3, 5;
+  soup.F.resize(6, 3);
+  soup.F << 3, 1, 2,  // shares the edge 1-2 with the next two faces: non-manifold
+      2, 1, 0,        //
+      1, 2, 4,        //
+      2, 1, 0,        // repeated
+      4, 4, 5,        // repeats a vertex
+      0, 4, 3;
+  std::set<std::pair<Index, Index>> edges;
+  for (Index f = 0; f < soup.F.rows(); ++f)
+    for (int k = 0; k < 3; ++k) {
+      const Index i = soup.F(f, k), j = soup.F(f, (k + 1) % 3);
+      if (i != j) edges.insert({std::min(i, j), std::max(i, j)});
+    }
+  SamplingOptions options;
+  options.samples = 0;
+  options.vertices = false;
+  const SurfaceSamples s = sample_surface(soup.V, soup.F, options);
+  ASSERT_EQ(s.num_edge_midpoints, static_cast<Index>(edges.size()));
+  Index k = 0;
+  for (const auto& [i, j] : edges) EXPECT_EQ(s.points.row(k++), 0.5 * (soup.V.row(i) + soup.V.row(j)));
 }
 
 // Above max_vertices_and_midpoints, an even subset of the vertices and of the edge midpoints
