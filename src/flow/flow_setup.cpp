@@ -71,7 +71,12 @@ FlowSetup prepare_flow(const Vertices& V, const Faces& F, const Topology& topolo
       fixed[static_cast<std::size_t>(i)] = 1;
   }
   // Centroid at the origin, mean edge length 1.
-  setup.centroid = V.colwise().mean();
+  // Summed in row order by hand: Eigen's V.colwise().mean() sums the columns that it loads as
+  // one packet in another order than the others, and which columns those are follows the
+  // destination's address modulo 16, so the bytes of the whole flow changed with the layout of
+  // FlowSetup (when SurfaceFeatures changed size, x and z moved by 1e-17).
+  for (Index i = 0; i < n; ++i) setup.centroid += V.row(i);
+  setup.centroid /= static_cast<double>(n);
   setup.mean_edge_length = mean_edge_length(V, topology);
   setup.scale = setup.mean_edge_length > 0 ? setup.mean_edge_length : 1.0;
   setup.input = normalised(V, setup);

@@ -18,6 +18,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <new>
 #include <numeric>
 
 namespace vertexflow {
@@ -282,6 +284,32 @@ TEST(FlowSolver, VertexFlowSameBytesForAnyThreadCount) {
   // The flow ran (mean displacement 0.14 mean edge lengths measured).
   EXPECT_GT((one - mesh.V).rowwise().norm().mean(),
             0.056 * mean_edge_length(mesh.V, build_topology(mesh.F, mesh.num_vertices())));
+}
+
+TEST(FlowSolver, SetUpDoesNotDependOnWhereItLives) {
+  // The centroid was Eigen's V.colwise().mean(), whose rounding followed the address of its
+  // destination modulo 16: the flow's bytes changed with FlowSetup's layout. Built at two
+  // addresses 8 bytes apart, the set-up must be the same, and the centroid the row-order mean.
+  const Mesh mesh = read_mesh(test::data_path("fandisk.off"));
+  const Topology topology = build_topology(mesh.F, mesh.num_vertices());
+  const FlowOptions options;
+  struct alignas(64) Buffer {
+    unsigned char bytes[sizeof(FlowSetup) + 16];
+  };
+  Buffer buffer[2];
+  FlowSetup* at[2];
+  for (int k = 0; k < 2; ++k)
+    at[k] = new (buffer[k].bytes + 8 * k) FlowSetup(prepare_flow(mesh.V, mesh.F, topology, options));
+  ASSERT_NE(reinterpret_cast<std::uintptr_t>(at[0]->centroid.data()) % 16,
+            reinterpret_cast<std::uintptr_t>(at[1]->centroid.data()) % 16);
+  Eigen::RowVector3d sum = Eigen::RowVector3d::Zero();
+  for (Eigen::Index i = 0; i < mesh.V.rows(); ++i)
+    for (int c = 0; c < 3; ++c) sum[c] += mesh.V(i, c);
+  for (int k = 0; k < 2; ++k) {
+    for (int c = 0; c < 3; ++c) EXPECT_EQ(at[k]->centroid[c], sum[c] / static_cast<double>(mesh.V.rows()));
+    EXPECT_EQ(at[k]->input, at[0]->input);
+  }
+  for (FlowSetup* setup : at) setup->~FlowSetup();
 }
 
 TEST(FlowSolver, ReusesItsAnalysisAcrossSolves) {
