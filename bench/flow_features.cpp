@@ -1,7 +1,7 @@
 // Experiment (not a benchmark): what the flow's feature detection (vertexflow/features.h) marks on
 // a mesh: sharp edges, creases, corners and patches at a given feature angle.
-#include "vertexflow/features.h"
 #include "vertexflow/curvature.h"
+#include "vertexflow/features.h"
 #include "vertexflow/io.h"
 #include "vertexflow/topology.h"
 
@@ -31,7 +31,7 @@ int main(int argc, char** argv) {
       if (s.vertex_kind[v] == SurfaceFeatures::Kind::Crease) ++crease;
       if (s.vertex_kind[v] == SurfaceFeatures::Kind::Corner) {
         ++corner;
-        ++by_count[s.vertex_sharp[v].size()];
+        ++by_count[static_cast<std::size_t>(s.sharp_count(static_cast<Index>(v)))];
       }
     }
     long sharp = 0;

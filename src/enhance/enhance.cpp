@@ -726,7 +726,7 @@ EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const
     throw EnhanceOptionError(std::string("enhance: ") + e.what());
   }
   const Index n = mesh.num_vertices();
-  const std::vector<Index> faces = enhance_detail::workable_faces(mesh);
+  std::vector<Index> faces = enhance_detail::workable_faces(mesh);
   const bool all_faces = faces.size() == static_cast<std::size_t>(mesh.num_faces());
   const Faces workable_F = all_faces ? Faces() : enhance_detail::face_rows(mesh.F, faces);
   const Faces& input_F = all_faces ? mesh.F : workable_F;
@@ -766,6 +766,11 @@ EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const
   if (whole && mesh.attributes.empty()) {
     // The flow takes the topology; the other modes build what they need, so it goes now.
     if (enhance_mode(options, reference != nullptr) != EnhanceMode::Flow) topology.reset();
+    // So do the maps of the partial paths: 21 bytes per vertex at the flow's peak.
+    std::vector<Index>().swap(faces);
+    std::vector<Index>().swap(to_work);
+    std::vector<Index>().swap(to_input);
+    std::vector<char>().swap(held);
     const ProgressPart part("", kPrepared, method_ends);
     return enhance_clean(mesh, reference, options, callbacks, topology ? &*topology : nullptr, true);
   }

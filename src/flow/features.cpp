@@ -29,7 +29,6 @@ SurfaceFeatures detect_features(const Vertices& V, const Faces& F, const Topolog
         topology.edge_face_count[static_cast<std::size_t>(first)] == 2)
       given[static_cast<std::size_t>(first)] = features.sharp_edge[static_cast<std::size_t>(first)] = 1;
   }
-  features.vertex_sharp.assign(static_cast<std::size_t>(topology.num_vertices), {});
   const double cosine = std::cos(angle_degrees * M_PI / 180.0);
   if (angle_degrees < 180) {
     for (Index f = 0; f < F.rows(); ++f) {
@@ -113,17 +112,28 @@ SurfaceFeatures detect_features(const Vertices& V, const Faces& F, const Topolog
         features.sharp_edge[e] = 0;
     }
   }
-  for (std::size_t e = 0; e < num_edges; ++e) {
-    if (!features.sharp_edge[e]) continue;
-    for (int end = 0; end < 2; ++end)
-      features.vertex_sharp[static_cast<std::size_t>(topology.edges(static_cast<Index>(e), end))].push_back(
-          static_cast<Index>(e));
+  // Each vertex's sharp edges, by a counting sort over the edges in order: so each list is
+  // increasing, which makes the projection's walks deterministic.
+  const auto n = static_cast<std::size_t>(topology.num_vertices);
+  features.sharp_start.assign(n + 1, 0);
+  for (std::size_t e = 0; e < num_edges; ++e)
+    if (features.sharp_edge[e])
+      for (int end = 0; end < 2; ++end)
+        ++features.sharp_start[static_cast<std::size_t>(topology.edges(static_cast<Index>(e), end)) + 1];
+  for (std::size_t v = 0; v < n; ++v) features.sharp_start[v + 1] += features.sharp_start[v];
+  features.sharp_at.resize(static_cast<std::size_t>(features.sharp_start[n]));
+  {
+    std::vector<Index> fill(features.sharp_start.begin(), features.sharp_start.end() - 1);
+    for (std::size_t e = 0; e < num_edges; ++e)
+      if (features.sharp_edge[e])
+        for (int end = 0; end < 2; ++end)
+          features.sharp_at[static_cast<std::size_t>(
+              fill[static_cast<std::size_t>(topology.edges(static_cast<Index>(e), end))]++)] = static_cast<Index>(e);
   }
   features.vertex_normals = vertex_normals(V, F);
-  features.vertex_kind.resize(static_cast<std::size_t>(topology.num_vertices));
-  for (std::size_t v = 0; v < features.vertex_kind.size(); ++v) {
-    std::sort(features.vertex_sharp[v].begin(), features.vertex_sharp[v].end());  // deterministic walks
-    const std::size_t count = features.vertex_sharp[v].size();
+  features.vertex_kind.resize(n);
+  for (std::size_t v = 0; v < n; ++v) {
+    const auto count = static_cast<std::size_t>(features.sharp_count(static_cast<Index>(v)));
     features.vertex_kind[v] = count == 0   ? SurfaceFeatures::Kind::Smooth
                               : count == 2 ? SurfaceFeatures::Kind::Crease
                                            : SurfaceFeatures::Kind::Corner;
@@ -132,7 +142,8 @@ SurfaceFeatures detect_features(const Vertices& V, const Faces& F, const Topolog
     if (count == 2) {
       Eigen::Vector3d direction[2];
       for (int k = 0; k < 2; ++k) {
-        const Index e = features.vertex_sharp[v][static_cast<std::size_t>(k)];
+        const Index e =
+            features.sharp_at[static_cast<std::size_t>(features.sharp_start[v]) + static_cast<std::size_t>(k)];
         const Index other = topology.edges(e, 0) == static_cast<Index>(v) ? topology.edges(e, 1) : topology.edges(e, 0);
         direction[k] = (V.row(other) - V.row(static_cast<Index>(v))).transpose();
       }

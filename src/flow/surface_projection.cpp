@@ -129,9 +129,7 @@ void project_near_vertices(Vertices& points, const std::vector<Index>& rows, con
     if (kind == SurfaceFeatures::Kind::Corner) {
       return;  // corners stay where they are (the flow fixes them too)
     } else if (kind == SurfaceFeatures::Kind::Crease) {
-      auto sharp_edges_of = [&](Index v, auto&& body) {
-        for (const Index e : features.vertex_sharp[static_cast<std::size_t>(v)]) body(e);
-      };
+      auto sharp_edges_of = [&](Index v, auto&& body) { features.for_each_sharp_edge(v, body); };
       best = walk([&](auto&& consider) { sharp_edges_of(i, consider); },
                   [&](Index e, auto&& consider) {
                     sharp_edges_of(topology.edges(e, 0), consider);

@@ -21,8 +21,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <functional>
-#include <initializer_list>
 #include <future>
+#include <initializer_list>
 #include <iostream>
 #include <limits>
 #include <random>
@@ -407,8 +407,8 @@ std::vector<std::vector<Index>> crease_chain_of_vertex(const SurfaceFeatures& fe
     while (!stack.empty()) {
       const Index v = stack.back();
       stack.pop_back();
-      for (const Index e : features.vertex_sharp[static_cast<std::size_t>(v)]) {
-        if (edge_taken[static_cast<std::size_t>(e)]) continue;
+      features.for_each_sharp_edge(v, [&](Index e) {
+        if (edge_taken[static_cast<std::size_t>(e)]) return;
         edge_taken[static_cast<std::size_t>(e)] = 1;
         chains.back().push_back(e);
         const Index w = topology.edges(e, 0) == v ? topology.edges(e, 1) : topology.edges(e, 0);
@@ -417,7 +417,7 @@ std::vector<std::vector<Index>> crease_chain_of_vertex(const SurfaceFeatures& fe
           chain_id[j] = id;
           stack.push_back(w);
         }
-      }
+      });
     }
   }
   std::vector<std::vector<Index>> per_vertex(n);
@@ -781,9 +781,9 @@ TEST(Flow, TakingTheTopologyGivesTheSameBytesAndFreesTheSetUpsParts) {
     expect_moved(*mesh, given.V, 0.1);
     EXPECT_TRUE((lent.V.array() == given.V.array()).all());
     EXPECT_EQ(borrowed.face_edges.rows(), mesh->num_faces());  // the borrowed one stays whole
-    if (manifold) {  // the flow ran on this topology, not on a split's
-      EXPECT_EQ(taken.face_adjacency.rows(), 0);  // NOLINT(bugprone-use-after-move): flow.h leaves it trimmed
-      EXPECT_TRUE(taken.edge_face_count.empty());  // NOLINT(bugprone-use-after-move)
+    if (manifold) {                                            // the flow ran on this topology, not on a split's
+      EXPECT_EQ(taken.face_adjacency.rows(), 0);           // NOLINT(bugprone-use-after-move): flow.h leaves it trimmed
+      EXPECT_TRUE(taken.edge_face_count.empty());          // NOLINT(bugprone-use-after-move)
       EXPECT_EQ(taken.num_edges(), borrowed.num_edges());  // NOLINT(bugprone-use-after-move)
     }
   }
