@@ -33,10 +33,11 @@ struct Local {
 
 }  // namespace
 
-FlowOperator::FlowOperator(const FlowTerms& terms) : t_(terms) {
-  const auto n = static_cast<std::size_t>(t_.n);
-  kx_.resize(3 * n);
-  qkr_.resize(9 * n);
+FlowOperator::FlowOperator(const FlowTerms& terms) : t_(terms) {}
+
+void FlowOperator::release_caches() {
+  std::vector<double>().swap(kx_);
+  std::vector<double>().swap(qkr_);
 }
 
 double FlowOperator::apply(const BlockVector& x, BlockVector& y) {
@@ -61,6 +62,9 @@ BlockVector FlowOperator::right_hand_side(const BlockVector& x) {
 // first(i) gives x_i (and may write it) in the first pass; the later passes read x.
 template <class First>
 double FlowOperator::passes(const BlockVector& x, BlockVector& y, bool with_d, bool with_rest, First&& first) {
+  const auto n = static_cast<std::size_t>(t_.n);
+  if (kx_.size() != 3 * n) kx_.resize(3 * n);
+  if (qkr_.size() != 9 * n) qkr_.resize(9 * n);
   parallel_for_index(t_.n, [&](Index i) {
     const Eigen::Vector3d xi = first(i);
     record<3>(kx_, i) = t_.K[static_cast<std::size_t>(i)] * xi;

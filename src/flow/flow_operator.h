@@ -27,6 +27,11 @@ class FlowOperator : public BlockOperator {
   /// half-gradient of the energy at d = 0, the normal equations' right-hand side (D drops out).
   BlockVector right_hand_side(const BlockVector& x);
 
+  /// Frees the per-vertex caches (96 bytes per vertex) until the next product allocates them
+  /// again: the multilevel set-up, the flow's peak on that path, runs between b and the first
+  /// product and does not need them.
+  void release_caches();
+
  private:
   template <class First>
   double passes(const BlockVector& x, BlockVector& y, bool with_d, bool with_rest, First&& first);

@@ -291,6 +291,7 @@ Vertices FlowSystemSolver::solve(const FlowFrame& frame, FlowFrame* release, con
   report.solver_iterations = 0;
   if (!direct && m > 0) {
     start = Clock::now();
+    op.release_caches();  // until the first iteration: the multilevel set-up is this path's peak
     std::unique_ptr<CoarseSpaceCorrection> multilevel;
     if (s.kind == LinearSolver::Multilevel ||
         (s.kind == LinearSolver::Automatic && largest_flat_region(terms) >= kFlatRegionForMultilevel))
@@ -307,6 +308,7 @@ Vertices FlowSystemSolver::solve(const FlowFrame& frame, FlowFrame* release, con
       if (!result.converged && cg.predicted_iterations(kSwitchPredictedAt) > kSwitchAbovePredicted) {
         report.seconds_solve += seconds_since(start);
         start = Clock::now();
+        op.release_caches();
         multilevel = make_multilevel(terms);
         if (multilevel) cg.use_correction(multilevel.get());
         report.seconds_factorization += seconds_since(start);
