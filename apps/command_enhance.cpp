@@ -198,7 +198,7 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     const ReferenceSurface* reference_pointer = reference ? &*reference : nullptr;
     // One line now rather than the OOM killer later (vertexflow/memory.h).
     require_memory_for_enhance(o->input, mesh.num_vertices(), !o->report_file.empty() || !o->html_file.empty(),
-                               reference ? static_cast<Index>(reference->vertices().rows()) : 0);
+                               reference ? static_cast<Index>(reference->vertices().rows()) : 0, options.flow.solver);
     // Trees over the reference's faces that the run and its report build (reference_surface.h).
     const std::uint64_t trees_before = reference ? distance_trees_built(reference->faces().rows()) : 0;
     EnhanceResult result;

@@ -5,6 +5,7 @@
 // and the Python module (vertexflow.enhance raises MemoryError).
 #pragma once
 
+#include "vertexflow/flow.h"
 #include "vertexflow/mesh.h"
 
 #include <cstdint>
@@ -21,13 +22,17 @@ class InsufficientMemoryError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-/// The whole process's peak resident memory for `enhance` on a mesh of `vertices` (bytes), from
-/// the measured peaks per vertex of docs/benchmarks.md ("Float factors and two fewer vertex
-/// copies"), rounded up: the flow's multilevel path (the larger), plus the reference's trees and
-/// curvature per reference vertex (`reference_vertices`, 0 for none). The report's metrics peak
-/// below the flow, so `with_report` does not change the estimate (require_memory_for_enhance
+/// The whole process's peak resident memory for `enhance` on a mesh of `vertices` (bytes): a
+/// fixed part plus bytes per vertex, both from the measured peaks of docs/benchmarks.md ("Fewer
+/// vectors through the solve"), rounded up, plus the reference's trees and curvature per
+/// reference vertex (`reference_vertices`, 0 for none). `solver` is the flow's
+/// (FlowOptions::solver): LinearSolver::Iterative never builds the multilevel hierarchy and
+/// peaks lower; the other choices are estimated by the multilevel path, which Automatic takes on
+/// large meshes (a forced Direct factorisation's fill is not modelled). The report's metrics
+/// peak below the flow, so `with_report` does not change the estimate (require_memory_for_enhance
 /// names it in its message). Never throws.
-std::uint64_t estimated_enhance_peak_bytes(Index vertices, bool with_report, Index reference_vertices);
+std::uint64_t estimated_enhance_peak_bytes(Index vertices, bool with_report, Index reference_vertices,
+                                           LinearSolver solver = LinearSolver::Automatic);
 
 /// What this process can still allocate (bytes), and which limit says so.
 struct AvailableMemory {
@@ -50,6 +55,7 @@ std::uint64_t peak_resident_bytes();
 /// when the estimate (estimated_enhance_peak_bytes), less what the process already holds
 /// (resident_bytes), exceeds available_memory(). `path` names the input in the message (a file's
 /// path, or a word such as "enhance" for arrays). Does nothing when nothing is known.
-void require_memory_for_enhance(const std::string& path, Index vertices, bool with_report, Index reference_vertices);
+void require_memory_for_enhance(const std::string& path, Index vertices, bool with_report, Index reference_vertices,
+                                LinearSolver solver = LinearSolver::Automatic);
 
 }  // namespace vertexflow

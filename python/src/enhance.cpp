@@ -54,7 +54,7 @@ py::tuple py_enhance(const py::handle& V, const py::handle& F, const py::dict& g
   // A run that would not fit raises MemoryError now, one line, rather than the OOM killer later
   // (memory.h). The arrays have no path; "enhance" names the call. No report's metrics here.
   require_memory_for_enhance("enhance", mesh.num_vertices(), /*with_report=*/false,
-                             dense ? static_cast<Index>(dense->vertices().rows()) : 0);
+                             dense ? static_cast<Index>(dense->vertices().rows()) : 0, options.flow.solver);
 
   const char* mode = enhance_mode_name(enhance_mode(options, has_reference));
   if (!progress.is_none())

@@ -101,7 +101,8 @@ void run_file(const std::filesystem::path& input, const std::filesystem::path& o
   // A file that would not fit is this file's error, one line naming it, and the batch goes on
   // (memory.h); with metrics, the estimate counts the report's peak, as `enhance --report` does.
   require_memory_for_enhance(input.string(), mesh.num_vertices(), options.metrics,
-                             reference ? static_cast<Index>(reference->vertices().rows()) : 0);
+                             reference ? static_cast<Index>(reference->vertices().rows()) : 0,
+                             options.enhance.flow.solver);
 
   start = Clock::now();
   const ReferenceSurface* reference_pointer = reference ? &*reference : nullptr;

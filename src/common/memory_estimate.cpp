@@ -13,12 +13,17 @@
 namespace vertexflow {
 namespace {
 
-// Measured peaks per vertex (docs/benchmarks.md, "Float factors and two fewer vertex copies"),
-// rounded up: the flow's multilevel path 1,289 B (arm1m), 1,108 B with --report (arm10m); the
-// block-Jacobi path 943 B (arm1m). The report's metrics now peak below the flow (870 against
-// 1,162 MiB at 1M, "The report's metrics after the issue 29 change"), so a report adds nothing
-// and one figure serves both. A reference vertex costs its distance tree, curvature and copies.
-constexpr double kBytesPerVertex = 1400;
+// Peak RSS = fixed part + bytes per vertex, fitted to the whole-process peaks measured at 1M and
+// 10M vertices (docs/benchmarks.md, "Fewer vectors through the solve") and rounded up. The
+// multilevel path: 1,013,896 KB at 1,081,027 vertices (arm1m, --solver multilevel) and
+// 8,349,316 KB at 9,729,227 (arm10m, the default, with --report), a slope of 868 B/vertex above
+// about 100 MB. Block-Jacobi alone (--solver iterative): 707,896 KB at 1M and 6,870,968 KB at
+// 10M with --report (there the report's metrics may be the peak), a slope of 730 B/vertex. The
+// report's metrics otherwise peak below the flow (843 against 1,014 MiB at 1M), so a report adds
+// nothing. A reference vertex costs its distance tree, curvature and copies.
+constexpr double kFixedBytes = 128.0 * 1024 * 1024;
+constexpr double kBytesPerVertexMultilevel = 900;
+constexpr double kBytesPerVertexBlockJacobi = 750;
 constexpr double kReferenceBytesPerVertex = 900;
 
 // A "Key:   N kB" line of a /proc file, in bytes.
@@ -51,8 +56,11 @@ double gib(std::uint64_t bytes) {
 
 }  // namespace
 
-std::uint64_t estimated_enhance_peak_bytes(Index vertices, bool /*with_report*/, Index reference_vertices) {
-  return static_cast<std::uint64_t>(kBytesPerVertex * vertices + kReferenceBytesPerVertex * reference_vertices);
+std::uint64_t estimated_enhance_peak_bytes(Index vertices, bool /*with_report*/, Index reference_vertices,
+                                           LinearSolver solver) {
+  const double per_vertex = solver == LinearSolver::Iterative ? kBytesPerVertexBlockJacobi : kBytesPerVertexMultilevel;
+  return static_cast<std::uint64_t>(kFixedBytes + per_vertex * vertices +
+                                    kReferenceBytesPerVertex * reference_vertices);
 }
 
 std::optional<AvailableMemory> available_memory() {
@@ -83,10 +91,11 @@ std::uint64_t peak_resident_bytes() {
   return static_cast<std::uint64_t>(usage.ru_maxrss) * 1024;  // KiB on Linux
 }
 
-void require_memory_for_enhance(const std::string& path, Index vertices, bool with_report, Index reference_vertices) {
+void require_memory_for_enhance(const std::string& path, Index vertices, bool with_report, Index reference_vertices,
+                                LinearSolver solver) {
   const std::optional<AvailableMemory> available = available_memory();
   if (!available) return;
-  const std::uint64_t estimate = estimated_enhance_peak_bytes(vertices, with_report, reference_vertices);
+  const std::uint64_t estimate = estimated_enhance_peak_bytes(vertices, with_report, reference_vertices, solver);
   const std::uint64_t held = resident_bytes();
   const std::uint64_t more = estimate > held ? estimate - held : 0;
   if (more <= available->bytes) return;
