@@ -5,11 +5,15 @@
 //   build/bin/make_large_mesh /tmp/armadillo-1m.ply /tmp/armadillo-1m.obj
 //
 // Options before the paths: --ply-float (float32 PLY coordinates), --ply-ascii,
-// --stl-ascii, --off-binary.
+// --stl-ascii, --off-binary, and --split N: each edge of that mesh split again in N (the size
+// ladder's larger rungs, docs/benchmarks.md: 3 gives the 9.7M-vertex mesh, 5 the 27M one).
+//
+//   build/bin/make_large_mesh --split 5 /tmp/arm27m.ply
 #include "bench_support.h"
 
 #include "vertexflow/io.h"
 
+#include <cstdlib>
 #include <exception>
 #include <iostream>
 #include <string>
@@ -18,14 +22,26 @@
 int main(int argc, char** argv) {
   vertexflow::WriteOptions options;
   std::vector<std::string> paths;
+  int split = 1;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
-    if (arg == "--ply-float") options.ply_double_precision = false;
-    else if (arg == "--ply-ascii") options.ply_encoding = vertexflow::PlyEncoding::Ascii;
-    else if (arg == "--stl-ascii") options.stl_binary = false;
-    else if (arg == "--off-binary") options.off_binary = true;
+    if (arg == "--split" && i + 1 < argc) {
+      split = std::atoi(argv[++i]);
+      if (split < 1 || split > 10) {
+        std::cerr << "make_large_mesh: --split needs a number from 1 to 10\n";
+        return 2;
+      }
+    } else if (arg == "--ply-float")
+      options.ply_double_precision = false;
+    else if (arg == "--ply-ascii")
+      options.ply_encoding = vertexflow::PlyEncoding::Ascii;
+    else if (arg == "--stl-ascii")
+      options.stl_binary = false;
+    else if (arg == "--off-binary")
+      options.off_binary = true;
     else if (arg == "-h" || arg == "--help") {
-      std::cout << "usage: make_large_mesh [--ply-float] [--ply-ascii] [--stl-ascii] [--off-binary] OUTPUT...\n";
+      std::cout
+          << "usage: make_large_mesh [--split N] [--ply-float] [--ply-ascii] [--stl-ascii] [--off-binary] OUTPUT...\n";
       return 0;
     } else if (!arg.empty() && arg[0] == '-') {
       std::cerr << "make_large_mesh: unknown option " << arg << '\n';
@@ -35,11 +51,13 @@ int main(int argc, char** argv) {
     }
   }
   if (paths.empty()) {
-    std::cerr << "usage: make_large_mesh [--ply-float] [--ply-ascii] [--stl-ascii] [--off-binary] OUTPUT...\n";
+    std::cerr
+        << "usage: make_large_mesh [--split N] [--ply-float] [--ply-ascii] [--stl-ascii] [--off-binary] OUTPUT...\n";
     return 2;
   }
   try {
-    const vertexflow::Mesh mesh = vertexflow::bench::make_large_test_mesh();
+    vertexflow::Mesh mesh = vertexflow::bench::make_large_test_mesh();
+    if (split > 1) mesh = vertexflow::bench::subdivide_uniform(mesh, split);
     if (!vertexflow::bench::report_topology(mesh, std::cout)) return 1;
     for (const std::string& path : paths) {
       vertexflow::write_mesh(path, mesh, options);
