@@ -171,7 +171,7 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
   if (releasable) release_set_up_parts(*releasable);
   std::optional<ReferenceSurface> surface;
   if (reference) {  // S in the flow's normalised units
-    const Vertices VS = (reference->V.rowwise() - setup.centroid) / setup.scale;
+    const Vertices VS = normalised(reference->V, setup);
     surface.emplace(ReferenceSurface{
         DistanceQuery(VS, reference->F),
         principal_curvatures(VS, reference->F, build_topology(reference->F, VS.rows()), options.curvature)});

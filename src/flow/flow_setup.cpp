@@ -45,13 +45,11 @@ std::vector<Eigen::Matrix3d> sliver_stiffness(const Vertices& X, const Faces& F,
   return stiffness;
 }
 
-// The normalisation (flow.h, "Scale and rigid motion"), in one place so that restoring the input
-// gives its bytes.
+}  // namespace
+
 Vertices normalised(const Vertices& V, const FlowSetup& setup) {
   return (V.rowwise() - setup.centroid) / setup.scale;
 }
-
-}  // namespace
 
 FlowSetup prepare_flow(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options) {
   const Index n = static_cast<Index>(V.rows());

@@ -35,6 +35,11 @@ struct FlowSetup {
 /// The preparation of vertex_flow for valid options and a valid mesh.
 FlowSetup prepare_flow(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options);
 
+/// Points in the flow's normalised units (flow.h, "Scale and rigid motion"): (V - centroid) /
+/// scale. The one place the normalisation is written, so that restoring the input gives its
+/// bytes and the reference is normalised as the input is.
+Vertices normalised(const Vertices& V, const FlowSetup& setup);
+
 /// Frees what a solve does not read of `setup` (the normalised input and the features' vertex
 /// normals: 48 bytes per vertex at the solve, the flow's peak); restore_after_solve(setup, V, F)
 /// with prepare_flow's V and F computes them again, bit for bit.

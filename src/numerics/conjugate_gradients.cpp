@@ -11,25 +11,19 @@ namespace vertexflow {
 
 ConjugateGradients::ConjugateGradients(BlockOperator& op, std::vector<Sym3> block_inverse, const BlockVector& b,
                                        PreconditionerCorrection* correction)
-    : op_(op),
-      correction_(correction),
-      inverse_(std::move(block_inverse)),
-      blocks_(static_cast<Index>(inverse_.size())) {
+    : op_(op), correction_(nullptr), inverse_(std::move(block_inverse)), blocks_(static_cast<Index>(inverse_.size())) {
   d_.setZero(b.size());
   r_ = b;
   hp_.resize(b.size());
   p_.resize(b.size());
-  if (correction_) z_.resize(b.size());
+  // Block-Jacobi's start, p = z = B r (z is not kept: PreconditionedResidual), then a
+  // correction's as use_correction starts it.
   rz_ = sum_over_vertices(blocks_, 0.0, [&](Index i) {
     const Eigen::Vector3d z = inverse_[static_cast<std::size_t>(i)] * block_at(r_, i);
-    if (correction_) block_at(z_, i) = z;
     block_at(p_, i) = z;
     return block_at(r_, i).dot(z);
   });
-  if (correction_) {
-    rz_ = correction_->add_to(r_, z_);
-    p_ = z_;
-  }
+  if (correction) use_correction(correction);
   b_norm_ = std::sqrt(deterministic_dot(b, b));
   r_norm_ = b_norm_;
 }
