@@ -196,9 +196,13 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
       reference.emplace(std::move(dense.V), std::move(dense.F), o->reference_file);
     }
     const ReferenceSurface* reference_pointer = reference ? &*reference : nullptr;
-    // One line now rather than the OOM killer later (vertexflow/memory.h).
-    require_memory_for_enhance(o->input, mesh.num_vertices(), !o->report_file.empty() || !o->html_file.empty(),
-                               reference ? static_cast<Index>(reference->vertices().rows()) : 0, options.flow.solver);
+    // One line now rather than the OOM killer later, or block-Jacobi alone where only the
+    // multilevel preconditioner would not fit (vertexflow/memory.h).
+    const EnhanceMemoryPlan memory_plan = plan_memory_for_enhance(
+        o->input, mesh.num_vertices(), !o->report_file.empty() || !o->html_file.empty(),
+        reference ? static_cast<Index>(reference->vertices().rows()) : 0, options.flow.solver);
+    options.flow.solver = memory_plan.solver;
+    if (!memory_plan.note.empty()) callbacks.warning(memory_plan.note);
     // Trees over the reference's faces that the run and its report build (reference_surface.h).
     const std::uint64_t trees_before = reference ? distance_trees_built(reference->faces().rows()) : 0;
     EnhanceResult result;
@@ -240,6 +244,7 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     }
     // The whole process's peak so far (the run, and the metrics above).
     report["peak_memory_bytes"] = peak_resident_bytes();
+    if (!memory_plan.note.empty()) report["solver"]["chosen_for_memory"] = memory_plan.note;
     if (!o->report_file.empty()) {
       write_text_file(o->report_file, report.dump(2) + "\n");
       phase("report written to " + o->report_file);

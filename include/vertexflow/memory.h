@@ -15,7 +15,7 @@
 
 namespace vertexflow {
 
-/// What require_memory_for_enhance throws: one line naming the input, the estimate and what is
+/// What plan_memory_for_enhance throws: one line naming the input, the estimate and what is
 /// available. Its own type so that front ends can map it (Python: MemoryError).
 class InsufficientMemoryError : public std::runtime_error {
  public:
@@ -29,7 +29,7 @@ class InsufficientMemoryError : public std::runtime_error {
 /// (FlowOptions::solver): LinearSolver::Iterative never builds the multilevel hierarchy and
 /// peaks lower; the other choices are estimated by the multilevel path, which Automatic takes on
 /// large meshes (a forced Direct factorisation's fill is not modelled). The report's metrics
-/// peak below the flow, so `with_report` does not change the estimate (require_memory_for_enhance
+/// peak below the flow, so `with_report` does not change the estimate (plan_memory_for_enhance
 /// names it in its message). Never throws.
 std::uint64_t estimated_enhance_peak_bytes(Index vertices, bool with_report, Index reference_vertices,
                                            LinearSolver solver = LinearSolver::Automatic);
@@ -50,12 +50,33 @@ std::uint64_t resident_bytes();
 /// This process's peak resident memory so far (getrusage ru_maxrss), in bytes; 0 if unknown.
 std::uint64_t peak_resident_bytes();
 
-/// Throws InsufficientMemoryError("PATH: enhancing N vertices[ with a report] needs about X GiB
-/// at its peak (...; H GiB of it held already), but only Y GiB more is available (limited_by)")
-/// when the estimate (estimated_enhance_peak_bytes), less what the process already holds
-/// (resident_bytes), exceeds available_memory(). `path` names the input in the message (a file's
-/// path, or a word such as "enhance" for arrays). Does nothing when nothing is known.
-void require_memory_for_enhance(const std::string& path, Index vertices, bool with_report, Index reference_vertices,
-                                LinearSolver solver = LinearSolver::Automatic);
+/// What enhance may run within the memory available (plan_memory_for_enhance).
+struct EnhanceMemoryPlan {
+  /// The solver to run: the one requested, or LinearSolver::Iterative in place of Automatic.
+  LinearSolver solver = LinearSolver::Automatic;
+  /// Empty, or one line saying why the solver was changed (for a warning and the report).
+  std::string note;
+};
+
+/// The check before a run. The plan is `solver` when its estimate (estimated_enhance_peak_bytes),
+/// less what the process already holds (`held`), fits in what is `available`. Where it does not:
+/// - `solver` Automatic, and block-Jacobi alone fits (LinearSolver::Iterative: no coarse
+///   hierarchy, about 150 bytes per vertex less; slower where large flat regions need the coarse
+///   space): the plan runs that instead of refusing, and `note` says so. Automatic's output
+///   bytes then depend on the memory available as well as on the mesh; both paths stop at the
+///   same relative residual (FlowOptions::solver_tolerance), so the vertices differ by far less
+///   than an edge length (docs/benchmarks.md, "Solver tolerance 1e-6").
+/// - otherwise throws InsufficientMemoryError("PATH: enhancing N vertices[ with a report] needs
+///   about X GiB at its peak (...; H GiB of it held already), but only Y GiB more is available
+///   (limited_by)"), X the estimate of the lightest path allowed. An explicit solver is never
+///   changed.
+/// `path` names the input in the messages (a file's path, or a word such as "enhance" for
+/// arrays). A nullopt `available` (nothing known) plans `solver` unchanged.
+EnhanceMemoryPlan plan_memory_for_enhance(const std::string& path, Index vertices, bool with_report,
+                                          Index reference_vertices, LinearSolver solver,
+                                          const std::optional<AvailableMemory>& available, std::uint64_t held);
+/// The same with what this process measures now: available_memory() and resident_bytes().
+EnhanceMemoryPlan plan_memory_for_enhance(const std::string& path, Index vertices, bool with_report,
+                                          Index reference_vertices, LinearSolver solver);
 
 }  // namespace vertexflow

@@ -40,7 +40,7 @@ std::optional<ReferenceSurface> reference_from(const py::object& reference) {
 py::tuple py_enhance(const py::handle& V, const py::handle& F, const py::dict& given, const py::object& reference,
                      const py::object& provenance, const py::object& attributes, int threads,
                      const py::object& progress) {
-  const EnhanceOptions options = enhance_options_from(given, "enhance");
+  EnhanceOptions options = enhance_options_from(given, "enhance");
   check_threads(threads);
   Mesh mesh = to_mesh(V, F);
   // Smooth mode reads the input's provenance from its comments, as the CLI's does from the file.
@@ -51,10 +51,14 @@ py::tuple py_enhance(const py::handle& V, const py::handle& F, const py::dict& g
   const bool has_reference = !reference.is_none();
   validate_enhance_options(options, has_reference, mesh.num_vertices(), OptionNaming::Python);
   const std::optional<ReferenceSurface> dense = reference_from(reference);
-  // A run that would not fit raises MemoryError now, one line, rather than the OOM killer later
-  // (memory.h). The arrays have no path; "enhance" names the call. No report's metrics here.
-  require_memory_for_enhance("enhance", mesh.num_vertices(), /*with_report=*/false,
-                             dense ? static_cast<Index>(dense->vertices().rows()) : 0, options.flow.solver);
+  // A run that would not fit raises MemoryError now, one line, rather than the OOM killer later;
+  // where only the multilevel preconditioner would not fit, block-Jacobi alone runs and the
+  // report's warnings say so (memory.h). The arrays have no path; "enhance" names the call. No
+  // report's metrics here.
+  const EnhanceMemoryPlan memory_plan =
+      plan_memory_for_enhance("enhance", mesh.num_vertices(), /*with_report=*/false,
+                              dense ? static_cast<Index>(dense->vertices().rows()) : 0, options.flow.solver);
+  options.flow.solver = memory_plan.solver;
 
   const char* mode = enhance_mode_name(enhance_mode(options, has_reference));
   if (!progress.is_none())
@@ -63,6 +67,7 @@ py::tuple py_enhance(const py::handle& V, const py::handle& F, const py::dict& g
   if (!progress.is_none()) progress("enhance: done");
 
   nlohmann::json report = std::move(result.report);
+  if (!memory_plan.note.empty()) result.warnings.insert(result.warnings.begin(), memory_plan.note);
   report["warnings"] = result.warnings;
   py::list out;
   out.append(to_numpy(std::move(result.mesh.V)));

@@ -98,17 +98,23 @@ void run_file(const std::filesystem::path& input, const std::filesystem::path& o
   row.vertices = mesh.num_vertices();
   row.faces = mesh.num_faces();
 
-  // A file that would not fit is this file's error, one line naming it, and the batch goes on
-  // (memory.h); with metrics, the estimate counts the report's peak, as `enhance --report` does.
-  require_memory_for_enhance(input.string(), mesh.num_vertices(), options.metrics,
-                             reference ? static_cast<Index>(reference->vertices().rows()) : 0,
-                             options.enhance.flow.solver);
+  // A file that would not fit is this file's error, one line naming it, and the batch goes on;
+  // where only the multilevel preconditioner would not fit, block-Jacobi alone runs, with a
+  // warning (memory.h). With metrics, the estimate counts the report's peak, as `enhance
+  // --report` does.
+  EnhanceOptions enhance_options = options.enhance;
+  const EnhanceMemoryPlan memory_plan =
+      plan_memory_for_enhance(input.string(), mesh.num_vertices(), options.metrics,
+                              reference ? static_cast<Index>(reference->vertices().rows()) : 0,
+                              enhance_options.flow.solver);
+  enhance_options.flow.solver = memory_plan.solver;
+  if (!memory_plan.note.empty()) warnings.push_back(memory_plan.note);
 
   start = Clock::now();
   const ReferenceSurface* reference_pointer = reference ? &*reference : nullptr;
   EnhanceResult result;
   try {
-    result = enhance(mesh, reference_pointer, options.enhance);
+    result = enhance(mesh, reference_pointer, enhance_options);
   } catch (const std::invalid_argument& e) {
     throw std::runtime_error(error_line(input, e.what()));
   }

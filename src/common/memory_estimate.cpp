@@ -91,19 +91,54 @@ std::uint64_t peak_resident_bytes() {
   return static_cast<std::uint64_t>(usage.ru_maxrss) * 1024;  // KiB on Linux
 }
 
-void require_memory_for_enhance(const std::string& path, Index vertices, bool with_report, Index reference_vertices,
-                                LinearSolver solver) {
-  const std::optional<AvailableMemory> available = available_memory();
-  if (!available) return;
+namespace {
+
+// The one line of InsufficientMemoryError if `solver`'s estimate, less what is held, exceeds
+// what is available; empty if it fits.
+std::string shortfall(const std::string& path, Index vertices, bool with_report, Index reference_vertices,
+                      LinearSolver solver, const AvailableMemory& available, std::uint64_t held) {
   const std::uint64_t estimate = estimated_enhance_peak_bytes(vertices, with_report, reference_vertices, solver);
-  const std::uint64_t held = resident_bytes();
   const std::uint64_t more = estimate > held ? estimate - held : 0;
-  if (more <= available->bytes) return;
-  throw InsufficientMemoryError(
-      fmt::format("{}: enhancing {} vertices{} needs about {:.2f} GiB at its peak (estimated from measured runs, "
-                  "docs/benchmarks.md; {:.2f} GiB of it held already), but only {:.2f} GiB more is available ({})",
-                  path, vertices, with_report ? " with a report" : "", gib(estimate), gib(held), gib(available->bytes),
-                  available->limited_by));
+  if (more <= available.bytes) return {};
+  return fmt::format("{}: enhancing {} vertices{} needs about {:.2f} GiB at its peak (estimated from measured runs, "
+                     "docs/benchmarks.md; {:.2f} GiB of it held already), but only {:.2f} GiB more is available ({})",
+                     path, vertices, with_report ? " with a report" : "", gib(estimate), gib(held),
+                     gib(available.bytes), available.limited_by);
+}
+
+}  // namespace
+
+EnhanceMemoryPlan plan_memory_for_enhance(const std::string& path, Index vertices, bool with_report,
+                                          Index reference_vertices, LinearSolver solver,
+                                          const std::optional<AvailableMemory>& available, std::uint64_t held) {
+  EnhanceMemoryPlan plan{solver, {}};
+  if (!available) return plan;
+  std::string refusal = shortfall(path, vertices, with_report, reference_vertices, solver, *available, held);
+  if (refusal.empty()) return plan;
+  if (solver == LinearSolver::Automatic) {
+    const LinearSolver lighter = LinearSolver::Iterative;
+    std::string lighter_refusal = shortfall(path, vertices, with_report, reference_vertices, lighter, *available, held);
+    if (lighter_refusal.empty()) {
+      plan.solver = lighter;
+      plan.note = fmt::format(
+          "the multilevel preconditioner would need about {:.2f} GiB at the peak ({:.2f} GiB of it held already), "
+          "but only {:.2f} GiB more is available ({}), so the flow runs block-Jacobi alone (about {:.2f} GiB; slower "
+          "on large flat regions)",
+          gib(estimated_enhance_peak_bytes(vertices, with_report, reference_vertices, solver)), gib(held),
+          gib(available->bytes), available->limited_by,
+          gib(estimated_enhance_peak_bytes(vertices, with_report, reference_vertices, lighter)));
+      return plan;
+    }
+    refusal = std::move(lighter_refusal);
+  }
+  throw InsufficientMemoryError(refusal);
+}
+
+EnhanceMemoryPlan plan_memory_for_enhance(const std::string& path, Index vertices, bool with_report,
+                                          Index reference_vertices, LinearSolver solver) {
+  const std::optional<AvailableMemory> available = available_memory();
+  return plan_memory_for_enhance(path, vertices, with_report, reference_vertices, solver, available,
+                                 available ? resident_bytes() : 0);
 }
 
 }  // namespace vertexflow

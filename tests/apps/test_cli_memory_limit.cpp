@@ -8,6 +8,7 @@
 #include "vertexflow/io.h"
 #include "vertexflow/memory.h"
 
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include <gtest/gtest.h>
@@ -89,6 +90,53 @@ TEST(CliMemoryLimit, ARunThatWouldNotFitIsRefusedBeforeItStartsWithOneLine) {
 #endif
 }
 
+// Where only the multilevel preconditioner would not fit, `enhance` runs block-Jacobi alone, says
+// so in one warning line and in the report, and writes its output. The limit is set between the
+// two paths' estimates from what a refused run says about this process: a limit that refuses
+// first (700 MB, as above), whose message gives what was available and held at the check.
+TEST(CliMemoryLimit, WhereOnlyTheMultilevelPathWouldNotFitBlockJacobiRunsAndSaysSo) {
+#ifdef VERTEXFLOW_TEST_ASAN
+  GTEST_SKIP() << "AddressSanitizer reserves terabytes of address space";
+#else
+  const test::ScratchDir scratch("memory-plan");
+  const std::string big = scratch.file("sphere655k.ply").string(), out = scratch.file("out.ply").string();
+  const std::string report = scratch.file("r.json").string();
+  const Mesh mesh = test::icosphere(1.0, 8);
+  write_mesh(big, mesh);
+  auto cli_under = [&](std::uint64_t limit_bytes, const std::string& arguments) {
+    return test::run_command("ulimit -v " + std::to_string(limit_bytes / 1024) + " && " +
+                             test::shell_quote(VERTEXFLOW_CLI) + " enhance " + test::shell_quote(big) + " " +
+                             test::shell_quote(out) + arguments);
+  };
+  const std::uint64_t first_limit = 700ull << 20;
+  const auto refused = cli_under(first_limit, "");
+  ASSERT_EQ(refused.exit_code, 1) << refused.err;
+  auto gib_before = [&](const std::string& words) {
+    const auto end = refused.err.find(words);
+    EXPECT_NE(end, std::string::npos) << refused.err;
+    const auto begin = refused.err.rfind(' ', end - 1) + 1;
+    return std::stod(refused.err.substr(begin, end - begin)) * (1ull << 30);
+  };
+  const double available = gib_before(" GiB more is available"), held = gib_before(" GiB of it held already");
+  const double multilevel = static_cast<double>(estimated_enhance_peak_bytes(mesh.num_vertices(), true, 0));
+  const double block_jacobi =
+      static_cast<double>(estimated_enhance_peak_bytes(mesh.num_vertices(), true, 0, LinearSolver::Iterative));
+  const double own = static_cast<double>(first_limit) - available;  // the address space at the check
+  const auto limit = static_cast<std::uint64_t>(own + (multilevel + block_jacobi) / 2 - held);
+  const auto r = cli_under(limit, " --report " + test::shell_quote(report));
+  ASSERT_EQ(r.exit_code, 0) << "ulimit -v " << limit / 1024 << ": " << r.err;
+  const std::string start = "vertexflow: warning: " + big + ": the multilevel preconditioner would need about ";
+  const auto line = r.err.find(start);
+  ASSERT_NE(line, std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("so the flow runs block-Jacobi alone", line), std::string::npos) << r.err;
+  const nlohmann::json j = nlohmann::json::parse(test::read_text(report));
+  EXPECT_EQ(j["options"]["solver"], "conjugate gradients");  // LinearSolver::Iterative by the plan
+  EXPECT_EQ(j["solver"]["method"], "conjugate gradients");  // no multilevel
+  EXPECT_NE(j["solver"]["chosen_for_memory"].get<std::string>().find("block-Jacobi alone"), std::string::npos);
+  EXPECT_TRUE(std::filesystem::exists(out));
+#endif
+}
+
 // The estimate is an upper bound of the whole process's peak, and not a loose one, on each
 // solver path it distinguishes: a 163,842-vertex sphere with a report measured 224.7 MB
 // (block-Jacobi) and 245.1 MB (multilevel) against estimates of 257.1 and 281.7 MB (1.15x).
@@ -112,6 +160,49 @@ TEST(CliMemoryLimit, TheEstimateBoundsTheMeasuredPeakOnEachSolverPath) {
   }
   EXPECT_LT(estimated_enhance_peak_bytes(1000000, false, 0, LinearSolver::Iterative),
             estimated_enhance_peak_bytes(1000000, false, 0, LinearSolver::Automatic));
+}
+
+// The plan before a run (memory.h) at 10M vertices, against what is available: Automatic keeps
+// its path when the multilevel estimate fits, runs block-Jacobi alone (and says so) when only that
+// fits, and refuses with the lighter path's estimate when neither does; an explicit solver is
+// never changed, and nothing known means no check.
+TEST(CliMemoryLimit, ThePlanRunsBlockJacobiAloneWhereOnlyTheMultilevelPathWouldNotFit) {
+  const Index n = 10000000;
+  const std::uint64_t multilevel = estimated_enhance_peak_bytes(n, false, 0, LinearSolver::Automatic);
+  const std::uint64_t block_jacobi = estimated_enhance_peak_bytes(n, false, 0, LinearSolver::Iterative);
+  ASSERT_LT(block_jacobi, multilevel);
+  const std::uint64_t held = 500u << 20;  // the mesh, read already
+  auto plan = [&](LinearSolver solver, std::uint64_t available) {
+    return plan_memory_for_enhance("scan.ply", n, false, 0, solver, AvailableMemory{available, "ulimit -v"}, held);
+  };
+  const EnhanceMemoryPlan roomy = plan(LinearSolver::Automatic, multilevel - held);
+  EXPECT_EQ(roomy.solver, LinearSolver::Automatic);
+  EXPECT_TRUE(roomy.note.empty()) << roomy.note;
+
+  const std::uint64_t between = (multilevel + block_jacobi) / 2 - held;
+  const EnhanceMemoryPlan tight = plan(LinearSolver::Automatic, between);
+  EXPECT_EQ(tight.solver, LinearSolver::Iterative);
+  EXPECT_NE(tight.note.find("block-Jacobi alone"), std::string::npos) << tight.note;
+  EXPECT_NE(tight.note.find("(ulimit -v)"), std::string::npos) << tight.note;
+  EXPECT_EQ(tight.note.find('\n'), std::string::npos) << tight.note;
+  EXPECT_EQ(plan(LinearSolver::Iterative, between).solver, LinearSolver::Iterative);
+  try {
+    plan(LinearSolver::Multilevel, between);
+    ADD_FAILURE() << "an explicit multilevel run that would not fit was not refused";
+  } catch (const InsufficientMemoryError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("scan.ply: enhancing 10000000 vertices needs about ", 0), 0u) << e.what();
+  }
+  try {
+    plan(LinearSolver::Automatic, block_jacobi - held - 1);
+    ADD_FAILURE() << "a run that fits on no path was not refused";
+  } catch (const InsufficientMemoryError& e) {
+    // The lighter path's estimate, the one that came closest.
+    const std::string expected = fmt::format("needs about {:.2f} GiB", static_cast<double>(block_jacobi) / (1 << 30));
+    EXPECT_NE(std::string(e.what()).find(expected), std::string::npos) << e.what();
+  }
+  const EnhanceMemoryPlan unknown =
+      plan_memory_for_enhance("scan.ply", n, false, 0, LinearSolver::Multilevel, std::nullopt, held);
+  EXPECT_EQ(unknown.solver, LinearSolver::Multilevel);
 }
 
 // The report records the process's peak memory: bunny_uniform's whole run measured 83 MB.
