@@ -100,10 +100,11 @@ std::string shortfall(const std::string& path, Index vertices, bool with_report,
   const std::uint64_t estimate = estimated_enhance_peak_bytes(vertices, with_report, reference_vertices, solver);
   const std::uint64_t more = estimate > held ? estimate - held : 0;
   if (more <= available.bytes) return {};
-  return fmt::format("{}: enhancing {} vertices{} needs about {:.2f} GiB at its peak (estimated from measured runs, "
-                     "docs/benchmarks.md; {:.2f} GiB of it held already), but only {:.2f} GiB more is available ({})",
-                     path, vertices, with_report ? " with a report" : "", gib(estimate), gib(held),
-                     gib(available.bytes), available.limited_by);
+  return fmt::format(
+      "{}: enhancing {} vertices{} needs about {:.2f} GiB at its peak (estimated from measured runs, "
+      "docs/benchmarks.md; {:.2f} GiB of it held already), but only {:.2f} GiB more is available ({})",
+      path, vertices, with_report ? " with a report" : "", gib(estimate), gib(held), gib(available.bytes),
+      available.limited_by);
 }
 
 }  // namespace
