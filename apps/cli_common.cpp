@@ -92,10 +92,8 @@ Mesh read_mesh_with_warnings(const std::filesystem::path& path, const GlobalOpti
 }
 
 void write_mesh_with_warnings(const std::filesystem::path& path, const Mesh& mesh, const GlobalOptions& global) {
-  const std::vector<std::string> lost = attributes_not_written(mesh, format_from_path(path));
-  if (!lost.empty() && !global.quiet)
-    fmt::print(stderr, "vertexflow: warning: {}: {} cannot hold, so it does not get: {}\n", path.string(),
-               format_name(format_from_path(path)), fmt::join(lost, ", "));
+  const std::string lost = attributes_not_written_warning(mesh, format_from_path(path));
+  if (!lost.empty() && !global.quiet) fmt::print(stderr, "vertexflow: warning: {}: {}\n", path.string(), lost);
   write_mesh(path, mesh);
 }
 

@@ -172,6 +172,10 @@ void write_mesh(const std::filesystem::path& path, const Mesh& mesh, const Write
 /// face channel and one two-component texture coordinate per corner. Empty when nothing is lost.
 std::vector<std::string> attributes_not_written(const Mesh& mesh, MeshFormat format, const WriteOptions& options = {});
 
+/// The one warning every front end gives for attributes_not_written: "FORMAT cannot hold, so it
+/// does not get: a, b" (format_name), or empty when nothing is lost.
+std::string attributes_not_written_warning(const Mesh& mesh, MeshFormat format, const WriteOptions& options = {});
+
 /// Writes `text` to `path` atomically (temporary file beside it, then rename). Throws IoError.
 void write_text_file(const std::filesystem::path& path, std::string_view text);
 

@@ -40,12 +40,9 @@ void py_write_mesh(const std::filesystem::path& path, const py::handle& V, const
   }
   // What the format cannot hold is named, as the CLI does (one UserWarning), never dropped
   // without a word.
-  const std::vector<std::string> lost = attributes_not_written(mesh, format_from_path(path), options);
+  const std::string lost = attributes_not_written_warning(mesh, format_from_path(path), options);
   if (!lost.empty()) {
-    std::string list;
-    for (const std::string& item : lost) list += (list.empty() ? "" : ", ") + item;
-    const std::string message =
-        path.string() + ": " + format_name(format_from_path(path)) + " cannot hold, so it does not get: " + list;
+    const std::string message = path.string() + ": " + lost;
     if (PyErr_WarnEx(PyExc_UserWarning, message.c_str(), 1) != 0) throw py::error_already_set();
   }
   py::gil_scoped_release release;

@@ -127,12 +127,9 @@ void run_file(const std::filesystem::path& input, const std::filesystem::path& o
 
   // The bytes `vertexflow enhance` writes: the engine's mesh, write_mesh's defaults.
   start = Clock::now();
-  const std::vector<std::string> lost = attributes_not_written(result.mesh, format_from_path(output));
+  const std::string lost = attributes_not_written_warning(result.mesh, format_from_path(output));
   if (!lost.empty()) {
-    std::string list;
-    for (const std::string& l : lost) list += (list.empty() ? "" : ", ") + l;
-    warnings.push_back(std::string(format_name(format_from_path(output))) +
-                       " cannot hold, so the output does not get: " + list);
+    warnings.push_back(lost);
     row.warnings = join(warnings);
   }
   write_mesh(output, result.mesh);

@@ -7,6 +7,7 @@
 #include <zlib.h>
 
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 
 #include <algorithm>
 #include <limits>
@@ -776,6 +777,12 @@ void write_mesh(const std::filesystem::path& path, const Mesh& mesh, const Write
       break;
   }
   out.commit();
+}
+
+std::string attributes_not_written_warning(const Mesh& mesh, MeshFormat format, const WriteOptions& options) {
+  const std::vector<std::string> lost = attributes_not_written(mesh, format, options);
+  if (lost.empty()) return {};
+  return fmt::format("{} cannot hold, so it does not get: {}", format_name(format), fmt::join(lost, ", "));
 }
 
 std::vector<std::string> attributes_not_written(const Mesh& mesh, MeshFormat format, const WriteOptions& options) {
