@@ -103,10 +103,9 @@ void run_file(const std::filesystem::path& input, const std::filesystem::path& o
   // warning (memory.h). With metrics, the estimate counts the report's peak, as `enhance
   // --report` does.
   EnhanceOptions enhance_options = options.enhance;
-  const EnhanceMemoryPlan memory_plan =
-      plan_memory_for_enhance(input.string(), mesh.num_vertices(), options.metrics,
-                              reference ? static_cast<Index>(reference->vertices().rows()) : 0,
-                              enhance_options.flow.solver);
+  const EnhanceMemoryPlan memory_plan = plan_memory_for_enhance(
+      input.string(), mesh.num_vertices(), options.metrics,
+      reference ? static_cast<Index>(reference->vertices().rows()) : 0, enhance_options.flow.solver);
   enhance_options.flow.solver = memory_plan.solver;
   if (!memory_plan.note.empty()) warnings.push_back(memory_plan.note);
 
