@@ -198,9 +198,9 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     const ReferenceSurface* reference_pointer = reference ? &*reference : nullptr;
     // One line now rather than the OOM killer later, or block-Jacobi alone where only the
     // multilevel preconditioner would not fit (vertexflow/memory.h).
-    const EnhanceMemoryPlan memory_plan = plan_memory_for_enhance(
-        o->input, mesh.num_vertices(), !o->report_file.empty() || !o->html_file.empty(),
-        reference ? static_cast<Index>(reference->vertices().rows()) : 0, options.flow.solver);
+    const EnhanceMemoryPlan memory_plan =
+        plan_memory_for_enhance(o->input, mesh.num_vertices(), !o->report_file.empty() || !o->html_file.empty(),
+                                reference ? static_cast<Index>(reference->vertices().rows()) : 0, options.flow.solver);
     options.flow.solver = memory_plan.solver;
     if (!memory_plan.note.empty()) callbacks.warning(memory_plan.note);
     // Trees over the reference's faces that the run and its report build (reference_surface.h).

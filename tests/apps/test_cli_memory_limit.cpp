@@ -131,7 +131,7 @@ TEST(CliMemoryLimit, WhereOnlyTheMultilevelPathWouldNotFitBlockJacobiRunsAndSays
   EXPECT_NE(r.err.find("so the flow runs block-Jacobi alone", line), std::string::npos) << r.err;
   const nlohmann::json j = nlohmann::json::parse(test::read_text(report));
   EXPECT_EQ(j["options"]["solver"], "conjugate gradients");  // LinearSolver::Iterative by the plan
-  EXPECT_EQ(j["solver"]["method"], "conjugate gradients");  // no multilevel
+  EXPECT_EQ(j["solver"]["method"], "conjugate gradients");   // no multilevel
   EXPECT_NE(j["solver"]["chosen_for_memory"].get<std::string>().find("block-Jacobi alone"), std::string::npos);
   EXPECT_TRUE(std::filesystem::exists(out));
 #endif
