@@ -3,19 +3,24 @@
 
 #include "vertexflow/quality.h"
 
+#include "common/bucket_by_key.h"
+#include "numerics/parallel.h"
+
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <span>
 #include <stdexcept>
 #include <vector>
 
 namespace vertexflow {
 namespace {
 
+// A face's side on the edge (a, b), a < b, kept in the bucket of a.
 struct EdgeSide {
-  Index a, b;  // the edge's vertices, a < b
+  Index b;
   Index face;
-  bool operator<(const EdgeSide& o) const { return a != o.a ? a < o.a : b != o.b ? b < o.b : face < o.face; }
+  bool operator<(const EdgeSide& o) const { return b != o.b ? b < o.b : face < o.face; }
 };
 
 }  // namespace
@@ -46,7 +51,7 @@ InputCheck check_input(const Vertices& V, const Faces& F, const InputCheckOption
   };
   std::vector<Eigen::Vector3d> normal(static_cast<std::size_t>(m));
   std::vector<char> has_normal(static_cast<std::size_t>(m), 0);
-  for (Index f = 0; f < m; ++f) {
+  parallel_for_index(m, [&](Index f) {
     const Eigen::Vector3d p = V.row(F(f, 0)).transpose(), q = V.row(F(f, 1)).transpose(),
                           r = V.row(F(f, 2)).transpose();
     const Eigen::Vector3d n = (q - p).cross(r - p);
@@ -55,41 +60,47 @@ InputCheck check_input(const Vertices& V, const Faces& F, const InputCheckOption
       normal[static_cast<std::size_t>(f)] = n / length;
       has_normal[static_cast<std::size_t>(f)] = 1;
     }
-  }
-  // Each edge's sides (faces with three distinct corners), sorted so an edge's faces are
-  // adjacent (deterministic, no hashing).
-  std::vector<EdgeSide> sides;
-  sides.reserve(static_cast<std::size_t>(3 * m));
-  for (Index f = 0; f < m; ++f)
-    if (distinct_corners(f))
-      for (int k = 0; k < 3; ++k) {
-        const Index u = F(f, k), w = F(f, (k + 1) % 3);
-        sides.push_back({std::min(u, w), std::max(u, w), f});
-      }
-  std::sort(sides.begin(), sides.end());
+  });
+  // Each edge's sides (faces with three distinct corners) in the bucket of its smaller vertex,
+  // each bucket sorted so an edge's faces are adjacent, in increasing order (deterministic, no
+  // hashing; a sort of all sides at once took 3% of a 10M-vertex run on one core).
+  KeyBuckets<EdgeSide> sides = bucket_by_key<EdgeSide>(static_cast<std::size_t>(V.rows()), [&](auto&& emit) {
+    for (Index f = 0; f < m; ++f)
+      if (distinct_corners(f))
+        for (int k = 0; k < 3; ++k) {
+          const Index u = F(f, k), w = F(f, (k + 1) % 3);
+          emit(static_cast<std::size_t>(std::min(u, w)), EdgeSide{std::max(u, w), f});
+        }
+  });
+  parallel_for_index(static_cast<Index>(V.rows()), [&](Index a) {
+    const std::span<EdgeSide> bucket = sides.of(static_cast<std::size_t>(a));
+    std::sort(bucket.begin(), bucket.end());
+  });
   const double cos_sharp = std::cos(kSharpEdgeAngle * std::numbers::pi / 180);
   Index sharp = 0;
   std::vector<char> on_boundary(static_cast<std::size_t>(V.rows()), 0);
-  for (std::size_t i = 0; i < sides.size();) {
-    std::size_t j = i + 1;
-    while (j < sides.size() && sides[j].a == sides[i].a && sides[j].b == sides[i].b) ++j;
-    if (j - i == 1)
-      on_boundary[static_cast<std::size_t>(sides[i].a)] = on_boundary[static_cast<std::size_t>(sides[i].b)] = 1;
-    // The interior edges of the sharp share: two sides that have a normal.
-    Index with_normal[2] = {0, 0};
-    std::size_t count = 0;
-    for (std::size_t k = i; k < j; ++k)
-      if (has_normal[static_cast<std::size_t>(sides[k].face)]) {
-        if (count < 2) with_normal[count] = sides[k].face;
-        ++count;
+  for (Index a = 0; a < static_cast<Index>(V.rows()); ++a) {
+    const std::span<EdgeSide> bucket = sides.of(static_cast<std::size_t>(a));
+    for (std::size_t i = 0; i < bucket.size();) {
+      std::size_t j = i + 1;
+      while (j < bucket.size() && bucket[j].b == bucket[i].b) ++j;
+      if (j - i == 1) on_boundary[static_cast<std::size_t>(a)] = on_boundary[static_cast<std::size_t>(bucket[i].b)] = 1;
+      // The interior edges of the sharp share: two sides that have a normal.
+      Index with_normal[2] = {0, 0};
+      std::size_t count = 0;
+      for (std::size_t k = i; k < j; ++k)
+        if (has_normal[static_cast<std::size_t>(bucket[k].face)]) {
+          if (count < 2) with_normal[count] = bucket[k].face;
+          ++count;
+        }
+      if (count == 2) {
+        ++check.interior_edges;
+        const double c =
+            normal[static_cast<std::size_t>(with_normal[0])].dot(normal[static_cast<std::size_t>(with_normal[1])]);
+        if (c < cos_sharp) ++sharp;
       }
-    if (count == 2) {
-      ++check.interior_edges;
-      const double c =
-          normal[static_cast<std::size_t>(with_normal[0])].dot(normal[static_cast<std::size_t>(with_normal[1])]);
-      if (c < cos_sharp) ++sharp;
+      i = j;
     }
-    i = j;
   }
   if (check.interior_edges > 0)
     check.sharp_edge_fraction = static_cast<double>(sharp) / static_cast<double>(check.interior_edges);

@@ -1,6 +1,8 @@
 // Sharp features of a mesh (include/vertexflow/features.h).
 #include "vertexflow/features.h"
 
+#include "common/bucket_by_key.h"
+
 #include "vertexflow/curvature.h"
 
 #include <algorithm>
@@ -115,21 +117,14 @@ SurfaceFeatures detect_features(const Vertices& V, const Faces& F, const Topolog
   // Each vertex's sharp edges, by a counting sort over the edges in order: so each list is
   // increasing, which makes the projection's walks deterministic.
   const auto n = static_cast<std::size_t>(topology.num_vertices);
-  features.sharp_start.assign(n + 1, 0);
-  for (std::size_t e = 0; e < num_edges; ++e)
-    if (features.sharp_edge[e])
-      for (int end = 0; end < 2; ++end)
-        ++features.sharp_start[static_cast<std::size_t>(topology.edges(static_cast<Index>(e), end)) + 1];
-  for (std::size_t v = 0; v < n; ++v) features.sharp_start[v + 1] += features.sharp_start[v];
-  features.sharp_at.resize(static_cast<std::size_t>(features.sharp_start[n]));
-  {
-    std::vector<Index> fill(features.sharp_start.begin(), features.sharp_start.end() - 1);
+  KeyBuckets<Index, Index> sharp = bucket_by_key<Index, Index>(n, [&](auto&& emit) {
     for (std::size_t e = 0; e < num_edges; ++e)
       if (features.sharp_edge[e])
         for (int end = 0; end < 2; ++end)
-          features.sharp_at[static_cast<std::size_t>(
-              fill[static_cast<std::size_t>(topology.edges(static_cast<Index>(e), end))]++)] = static_cast<Index>(e);
-  }
+          emit(static_cast<std::size_t>(topology.edges(static_cast<Index>(e), end)), static_cast<Index>(e));
+  });
+  features.sharp_start = std::move(sharp.start);
+  features.sharp_at = std::move(sharp.items);
   features.vertex_normals = vertex_normals(V, F);
   features.vertex_kind.resize(n);
   for (std::size_t v = 0; v < n; ++v) {

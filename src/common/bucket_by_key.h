@@ -1,0 +1,45 @@
+// Internal: items grouped by an integer key in compressed rows, by a counting sort.
+//
+// The mesh stages group things by vertex again and again (a vertex's sharp edges, an edge's
+// sides by its smaller vertex): a comparison sort of every item costs n log n and runs on one
+// core, while counting the keys, summing the counts and placing each item is linear and keeps
+// the items of a key in the order they were given, so the result needs no tie-break to be
+// deterministic.
+#pragma once
+
+#include <cstddef>
+#include <span>
+#include <vector>
+
+namespace vertexflow {
+
+/// The items of each key k in [0, num_keys): items[start[k] .. start[k + 1]), in the order
+/// they were emitted. `Offset` may be a 32-bit index where the item count allows (4 bytes per
+/// key fewer).
+template <class Item, class Offset = std::size_t>
+struct KeyBuckets {
+  std::vector<Offset> start;
+  std::vector<Item> items;
+
+  [[nodiscard]] std::span<Item> of(std::size_t key) {
+    const auto begin = static_cast<std::size_t>(start[key]), end = static_cast<std::size_t>(start[key + 1]);
+    return {items.data() + begin, end - begin};
+  }
+};
+
+/// Groups items by key: `for_each(emit)` calls emit(key, item) for every item, with key in
+/// [0, num_keys), and must emit the same sequence each time, as it is called twice (once to
+/// count, once to place). A stable counting sort: linear time, items of a key in emitted order.
+template <class Item, class Offset = std::size_t, class ForEach>
+KeyBuckets<Item, Offset> bucket_by_key(std::size_t num_keys, ForEach&& for_each) {
+  KeyBuckets<Item, Offset> buckets;
+  buckets.start.assign(num_keys + 1, 0);
+  for_each([&](std::size_t key, const Item&) { ++buckets.start[key + 1]; });
+  for (std::size_t k = 0; k < num_keys; ++k) buckets.start[k + 1] += buckets.start[k];
+  buckets.items.resize(static_cast<std::size_t>(buckets.start[num_keys]));
+  std::vector<Offset> fill(buckets.start.begin(), buckets.start.end() - 1);
+  for_each([&](std::size_t key, const Item& item) { buckets.items[static_cast<std::size_t>(fill[key]++)] = item; });
+  return buckets;
+}
+
+}  // namespace vertexflow
