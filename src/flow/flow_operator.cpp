@@ -1,5 +1,6 @@
 #include "flow_operator.h"
 
+#include "common/bucket_by_key.h"
 #include "numerics/parallel.h"
 
 #include <tbb/enumerable_thread_specific.h>
@@ -151,9 +152,8 @@ BlockSparseMatrix galerkin_upper(const FlowTerms& t, const AggregationCoarseSpac
   std::vector<Index> vertices;
   std::vector<std::size_t> local_start;
   std::vector<Local> locals;
-  std::size_t first = 0;                                         // the range's first aggregate
-  std::vector<std::size_t> touch_start;                          // per aggregate of the range
-  std::vector<std::pair<std::uint32_t, std::uint32_t>> touches;  // (vertex in range, k)
+  std::size_t first = 0;                                        // the range's first aggregate
+  KeyBuckets<std::pair<std::uint32_t, std::uint32_t>> touches;  // per aggregate of the range: (vertex in range, k)
   auto prepare = [&](int range_first, int range_last) {
     const auto a0 = static_cast<std::size_t>(range_first), a1 = static_cast<std::size_t>(range_last);
     first = a0;
@@ -196,27 +196,21 @@ BlockSparseMatrix galerkin_upper(const FlowTerms& t, const AggregationCoarseSpac
       std::sort(out, out + size, [](const Local& x, const Local& y) { return x.aggregate < y.aggregate; });
     });
     // The locals of each aggregate of the range, by vertex (counting sort, so in vertex order).
-    touch_start.assign(a1 - a0 + 1, 0);
-    for (const Local& x : locals)
-      if (static_cast<std::size_t>(x.aggregate) >= a0 && static_cast<std::size_t>(x.aggregate) < a1)
-        ++touch_start[static_cast<std::size_t>(x.aggregate) - a0 + 1];
-    for (std::size_t a = a0; a < a1; ++a) touch_start[a - a0 + 1] += touch_start[a - a0];
-    touches.resize(touch_start.back());
-    std::vector<std::size_t> fill(touch_start.begin(), touch_start.end() - 1);
-    for (std::size_t c = 0; c < m; ++c)
-      for (std::size_t k = local_start[c]; k < local_start[c + 1]; ++k) {
-        const auto a = static_cast<std::size_t>(locals[k].aggregate);
-        if (a >= a0 && a < a1)
-          touches[fill[a - a0]++] = {static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(k - local_start[c])};
-      }
+    touches = bucket_by_key<std::pair<std::uint32_t, std::uint32_t>>(a1 - a0, [&](auto&& emit) {
+      for (std::size_t c = 0; c < m; ++c)
+        for (std::size_t k = local_start[c]; k < local_start[c + 1]; ++k) {
+          const auto a = static_cast<std::size_t>(locals[k].aggregate);
+          if (a >= a0 && a < a1)
+            emit(a - a0, std::pair{static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(k - local_start[c])});
+        }
+    });
   };
   // Row a of the upper half of H_c: blocks (a, b), b >= a, summed over the vertices in order.
   return build_block_rows(
       static_cast<int>(na), static_cast<int>(na),
       [&](int a, BlockRowAccumulator& row) {
         const std::size_t r = static_cast<std::size_t>(a) - first;
-        for (std::size_t e = touch_start[r]; e < touch_start[r + 1]; ++e) {
-          const auto [c, k] = touches[e];
+        for (const auto& [c, k] : touches.of(r)) {
           const auto v = static_cast<std::size_t>(vertices[c]);
           const Local* local = locals.data() + local_start[c];
           const Local& x = local[k];

@@ -1,5 +1,7 @@
 #include "vertexflow/topology.h"
 
+#include "common/bucket_by_key.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -53,9 +55,7 @@ bool order_one_ring(Index v, const Faces& F, Index* faces, Index count, Index* r
   thread_local std::vector<Index> ordered_faces;
   thread_local std::vector<Index> check;
   // Wedge w spans link vertices a(w) -> b(w).
-  auto corner = [&](Index f) {
-    return F(f, 0) == v ? 0 : F(f, 1) == v ? 1 : 2;
-  };
+  auto corner = [&](Index f) { return F(f, 0) == v ? 0 : F(f, 1) == v ? 1 : 2; };
   auto a_of = [&](Index f) { return F(f, (corner(f) + 1) % 3); };
   auto b_of = [&](Index f) { return F(f, (corner(f) + 2) % 3); };
 
@@ -154,7 +154,8 @@ std::int64_t Topology::genus() const {
 
 double mean_edge_length(const Vertices& V, const Topology& topology) {
   double sum = 0;
-  for (Index e = 0; e < topology.num_edges(); ++e) sum += (V.row(topology.edges(e, 0)) - V.row(topology.edges(e, 1))).norm();
+  for (Index e = 0; e < topology.num_edges(); ++e)
+    sum += (V.row(topology.edges(e, 0)) - V.row(topology.edges(e, 1))).norm();
   return topology.num_edges() > 0 ? sum / topology.num_edges() : 0.0;
 }
 
@@ -184,14 +185,12 @@ Topology build_topology(const Faces& F, Index num_vertices) {
 
   // Vertex -> faces (counting sort, faces in increasing order per vertex).
   {
-    std::vector<Index> counts(static_cast<std::size_t>(nv), 0);
-    for (Eigen::Index i = 0; i < F.size(); ++i) ++counts[static_cast<std::size_t>(F.data()[i])];
-    t.face_offsets = offsets_from_counts(counts);
-    t.vertex_faces.resize(static_cast<std::size_t>(3) * static_cast<std::size_t>(nf));
-    std::vector<Index> fill(t.face_offsets.begin(), t.face_offsets.end() - 1);
-    for (Index f = 0; f < nf; ++f) {
-      for (int k = 0; k < 3; ++k) t.vertex_faces[static_cast<std::size_t>(fill[static_cast<std::size_t>(F(f, k))]++)] = f;
-    }
+    KeyBuckets<Index, Index> faces = bucket_by_key<Index, Index>(static_cast<std::size_t>(nv), [&](auto&& emit) {
+      for (Index f = 0; f < nf; ++f)
+        for (int k = 0; k < 3; ++k) emit(static_cast<std::size_t>(F(f, k)), f);
+    });
+    t.face_offsets = std::move(faces.start);
+    t.vertex_faces = std::move(faces.items);
   }
   auto incident_faces = [&](Index v) {
     return std::pair{t.vertex_faces.data() + t.face_offsets[v], t.vertex_faces.data() + t.face_offsets[v + 1]};
@@ -216,16 +215,20 @@ Topology build_topology(const Faces& F, Index num_vertices) {
   std::vector<Index> scratch_neighbours(2 * t.vertex_faces.size());
   parallel_vertices(nv, [&](Index v, std::vector<Index>& scratch) {
     larger_neighbours(v, scratch);
-    std::copy(scratch.begin(), scratch.end(), scratch_neighbours.begin() + 2 * static_cast<std::ptrdiff_t>(t.face_offsets[static_cast<std::size_t>(v)]));
+    std::copy(
+        scratch.begin(), scratch.end(),
+        scratch_neighbours.begin() + 2 * static_cast<std::ptrdiff_t>(t.face_offsets[static_cast<std::size_t>(v)]));
     edge_counts[static_cast<std::size_t>(v)] = static_cast<Index>(scratch.size());
   });
   const std::vector<Index> edge_offsets = offsets_from_counts(edge_counts);
   const Index ne = edge_offsets.back();
   t.edges.resize(ne, 2);
   parallel_vertices(nv, [&](Index v, std::vector<Index>&) {
-    const Index* source = scratch_neighbours.data() + 2 * static_cast<std::size_t>(t.face_offsets[static_cast<std::size_t>(v)]);
+    const Index* source =
+        scratch_neighbours.data() + 2 * static_cast<std::size_t>(t.face_offsets[static_cast<std::size_t>(v)]);
     Index e = edge_offsets[static_cast<std::size_t>(v)];
-    for (Index i = 0; i < edge_counts[static_cast<std::size_t>(v)]; ++i, ++e) t.edges(e, 0) = v, t.edges(e, 1) = source[i];
+    for (Index i = 0; i < edge_counts[static_cast<std::size_t>(v)]; ++i, ++e)
+      t.edges(e, 0) = v, t.edges(e, 1) = source[i];
   });
   scratch_neighbours = std::vector<Index>();
   // A vertex's edges are sorted by their other end: binary search, since one vertex can own
@@ -235,8 +238,10 @@ Topology build_topology(const Faces& F, Index num_vertices) {
     Index low = edge_offsets[static_cast<std::size_t>(a)], high = edge_offsets[static_cast<std::size_t>(a) + 1];
     while (low < high) {
       const Index middle = low + (high - low) / 2;
-      if (t.edges.data()[2 * static_cast<std::size_t>(middle) + 1] < b) low = middle + 1;
-      else high = middle;
+      if (t.edges.data()[2 * static_cast<std::size_t>(middle) + 1] < b)
+        low = middle + 1;
+      else
+        high = middle;
     }
     return low;  // every face edge was recorded above, so this is it
   };
@@ -284,7 +289,8 @@ Topology build_topology(const Faces& F, Index num_vertices) {
   // One-rings: valence is the number of incident edges.
   {
     std::vector<Index> valence(static_cast<std::size_t>(nv), 0);
-    for (Index e = 0; e < ne; ++e) ++valence[static_cast<std::size_t>(t.edges(e, 0))], ++valence[static_cast<std::size_t>(t.edges(e, 1))];
+    for (Index e = 0; e < ne; ++e)
+      ++valence[static_cast<std::size_t>(t.edges(e, 0))], ++valence[static_cast<std::size_t>(t.edges(e, 1))];
     t.ring_offsets = offsets_from_counts(valence);
   }
   t.ring_vertices.resize(static_cast<std::size_t>(t.ring_offsets.back()));
@@ -292,11 +298,13 @@ Topology build_topology(const Faces& F, Index num_vertices) {
   t.is_boundary_vertex.assign(static_cast<std::size_t>(nv), 0);
   for (Index e = 0; e < ne; ++e) {
     if (t.edge_face_count[static_cast<std::size_t>(e)] == 1)
-      t.is_boundary_vertex[static_cast<std::size_t>(t.edges(e, 0))] = t.is_boundary_vertex[static_cast<std::size_t>(t.edges(e, 1))] = 1;
+      t.is_boundary_vertex[static_cast<std::size_t>(t.edges(e, 0))] =
+          t.is_boundary_vertex[static_cast<std::size_t>(t.edges(e, 1))] = 1;
   }
   parallel_vertices(nv, [&](Index v, std::vector<Index>& scratch) {
     Index* ring = t.ring_vertices.data() + t.ring_offsets[static_cast<std::size_t>(v)];
-    const Index ring_size = t.ring_offsets[static_cast<std::size_t>(v) + 1] - t.ring_offsets[static_cast<std::size_t>(v)];
+    const Index ring_size =
+        t.ring_offsets[static_cast<std::size_t>(v) + 1] - t.ring_offsets[static_cast<std::size_t>(v)];
     Index* faces = t.vertex_faces.data() + t.face_offsets[static_cast<std::size_t>(v)];
     const Index count = t.face_offsets[static_cast<std::size_t>(v) + 1] - t.face_offsets[static_cast<std::size_t>(v)];
     if (count == 0) return;  // isolated vertex: manifold in the trivial sense, empty ring
@@ -304,7 +312,8 @@ Topology build_topology(const Faces& F, Index num_vertices) {
     t.is_manifold_vertex[static_cast<std::size_t>(v)] = 0;
     std::sort(faces, faces + count);
     Index filled = 0;
-    for (Index e = edge_offsets[static_cast<std::size_t>(v)]; e < edge_offsets[static_cast<std::size_t>(v) + 1]; ++e) ring[filled++] = t.edges(e, 1);
+    for (Index e = edge_offsets[static_cast<std::size_t>(v)]; e < edge_offsets[static_cast<std::size_t>(v) + 1]; ++e)
+      ring[filled++] = t.edges(e, 1);
     // Smaller neighbours own the edge: scan incident faces for them.
     scratch.clear();
     for (Index i = 0; i < count; ++i) {
@@ -334,7 +343,8 @@ Topology build_topology(const Faces& F, Index num_vertices) {
     std::sort(half_edges.begin(), half_edges.end());
     std::vector<char> used(half_edges.size(), 0);
     auto first_out = [&](Index from) {
-      return std::lower_bound(half_edges.begin(), half_edges.end(), std::make_pair(from, Index{-1})) - half_edges.begin();
+      return std::lower_bound(half_edges.begin(), half_edges.end(), std::make_pair(from, Index{-1})) -
+             half_edges.begin();
     };
     for (std::size_t h0 = 0; h0 < half_edges.size(); ++h0) {
       if (used[h0]) continue;
@@ -346,10 +356,12 @@ Topology build_topology(const Faces& F, Index num_vertices) {
         const Index to = half_edges[h].second;
         if (to == half_edges[h0].first) break;
         std::ptrdiff_t next = first_out(to);
-        while (next < static_cast<std::ptrdiff_t>(half_edges.size()) && half_edges[static_cast<std::size_t>(next)].first == to &&
-               used[static_cast<std::size_t>(next)])
+        while (next < static_cast<std::ptrdiff_t>(half_edges.size()) &&
+               half_edges[static_cast<std::size_t>(next)].first == to && used[static_cast<std::size_t>(next)])
           ++next;
-        if (next >= static_cast<std::ptrdiff_t>(half_edges.size()) || half_edges[static_cast<std::size_t>(next)].first != to) break;
+        if (next >= static_cast<std::ptrdiff_t>(half_edges.size()) ||
+            half_edges[static_cast<std::size_t>(next)].first != to)
+          break;
         h = static_cast<std::size_t>(next);
       }
       t.boundary_loops.push_back(std::move(loop));
@@ -368,7 +380,8 @@ Topology build_topology(const Faces& F, Index num_vertices) {
       t.vertex_component[static_cast<std::size_t>(v)] = l;
     }
     t.face_component.resize(static_cast<std::size_t>(nf));
-    for (Index f = 0; f < nf; ++f) t.face_component[static_cast<std::size_t>(f)] = t.vertex_component[static_cast<std::size_t>(F(f, 0))];
+    for (Index f = 0; f < nf; ++f)
+      t.face_component[static_cast<std::size_t>(f)] = t.vertex_component[static_cast<std::size_t>(F(f, 0))];
   }
   return t;
 }
