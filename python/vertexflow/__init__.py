@@ -137,6 +137,10 @@ progress: progress(str) is called before and after the work.
 The options are those of the library's table, which the CLI's flags also come from. An option
 set to other than its default in a mode it does not apply to raises ValueError naming it, as the
 CLI refuses it; so does a value out of its range.
+
+Before the run, its peak memory is estimated from the vertex count (vertexflow/memory.h): a run
+that would not fit raises MemoryError with one line; where only the default solver's multilevel
+preconditioner would not fit, the flow runs block-Jacobi alone and report["warnings"] says so.
 """)
 
 enhance_file = _front_end(
