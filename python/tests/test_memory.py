@@ -23,19 +23,12 @@ import json, resource, sys
 import numpy as np
 import vertexflow
 
-def vm_size():
+def status_bytes(key):  # a "Key:  N kB" line of /proc/self/status, in bytes
     with open("/proc/self/status") as status:
         for line in status:
-            if line.startswith("VmSize:"):
+            if line.startswith(key + ":"):
                 return int(line.split()[1]) * 1024
-    raise RuntimeError("no VmSize")
-
-def vm_rss():
-    with open("/proc/self/status") as status:
-        for line in status:
-            if line.startswith("VmRSS:"):
-                return int(line.split()[1]) * 1024
-    raise RuntimeError("no VmRSS")
+    raise RuntimeError("no " + key)
 
 headroom, mesh = int(sys.argv[1]) * 1024 * 1024, sys.argv[2]
 if mesh.startswith("grid"):
@@ -50,8 +43,8 @@ if headroom == 0:
     # Between the two paths' estimates (vertexflow/memory.h: 128 MiB plus 900 B per vertex with
     # the multilevel preconditioner, 750 without), less what this process holds already.
     estimate = lambda per_vertex: 128 * 2**20 + per_vertex * len(V)
-    headroom = (estimate(900) + estimate(750)) // 2 - vm_rss()
-limit = vm_size() + headroom
+    headroom = (estimate(900) + estimate(750)) // 2 - status_bytes("VmRSS")
+limit = status_bytes("VmSize") + headroom
 resource.setrlimit(resource.RLIMIT_AS, (limit, resource.getrlimit(resource.RLIMIT_AS)[1]))
 try:
     out = vertexflow.enhance(V, F)

@@ -61,6 +61,21 @@ TEST(CliMemoryLimit, EveryRunEndsWithSuccessOrOneErrorLine) {
 #endif
 }
 
+// A 655,362-vertex sphere in a scratch directory, and `vertexflow enhance` on it under an
+// address-space limit (`ulimit -v`).
+struct SphereUnderLimit {
+  test::ScratchDir scratch;
+  Mesh mesh = test::icosphere(1.0, 8);
+  std::string path = scratch.file("sphere655k.ply").string(), out = scratch.file("out.ply").string();
+
+  explicit SphereUnderLimit(const std::string& tag) : scratch(tag) { write_mesh(path, mesh); }
+  [[nodiscard]] test::CommandResult enhance(std::uint64_t limit_bytes, const std::string& arguments = "") const {
+    return test::run_command("ulimit -v " + std::to_string(limit_bytes / 1024) + " && " +
+                             test::shell_quote(VERTEXFLOW_CLI) + " enhance " + test::shell_quote(path) + " " +
+                             test::shell_quote(out) + arguments);
+  }
+};
+
 // Before a run that would not fit, the CLI estimates its peak from the mesh size and stops with
 // one line naming the file, the estimate and what is available (issue 29), instead of failing
 // an allocation halfway or being killed. 655,362 vertices need about 0.68 GiB by the estimate
@@ -70,14 +85,12 @@ TEST(CliMemoryLimit, ARunThatWouldNotFitIsRefusedBeforeItStartsWithOneLine) {
 #ifdef VERTEXFLOW_TEST_ASAN
   GTEST_SKIP() << "AddressSanitizer reserves terabytes of address space";
 #else
-  const test::ScratchDir scratch("memory-estimate");
-  const std::string big = scratch.file("sphere655k.ply").string(), out = scratch.file("out.ply").string();
-  write_mesh(big, test::icosphere(1.0, 8));
+  const SphereUnderLimit sphere("memory-estimate");
+  const std::string& out = sphere.out;
   const std::string limit = "ulimit -v " + std::to_string(700 * 1024) + " && ";
-  const auto refused = test::run_command(limit + test::shell_quote(VERTEXFLOW_CLI) + " enhance " +
-                                         test::shell_quote(big) + " " + test::shell_quote(out));
+  const auto refused = sphere.enhance(700ull << 20);
   EXPECT_EQ(refused.exit_code, 1) << refused.err;
-  const std::string start = "vertexflow: error: " + big + ": enhancing 655362 vertices needs about ";
+  const std::string start = "vertexflow: error: " + sphere.path + ": enhancing 655362 vertices needs about ";
   const auto line = refused.err.find(start);
   ASSERT_NE(line, std::string::npos) << refused.err;
   EXPECT_EQ(refused.err.find('\n', line), refused.err.size() - 1) << refused.err;  // the last line, one line
@@ -98,18 +111,11 @@ TEST(CliMemoryLimit, WhereOnlyTheMultilevelPathWouldNotFitBlockJacobiRunsAndSays
 #ifdef VERTEXFLOW_TEST_ASAN
   GTEST_SKIP() << "AddressSanitizer reserves terabytes of address space";
 #else
-  const test::ScratchDir scratch("memory-plan");
-  const std::string big = scratch.file("sphere655k.ply").string(), out = scratch.file("out.ply").string();
-  const std::string report = scratch.file("r.json").string();
-  const Mesh mesh = test::icosphere(1.0, 8);
-  write_mesh(big, mesh);
-  auto cli_under = [&](std::uint64_t limit_bytes, const std::string& arguments) {
-    return test::run_command("ulimit -v " + std::to_string(limit_bytes / 1024) + " && " +
-                             test::shell_quote(VERTEXFLOW_CLI) + " enhance " + test::shell_quote(big) + " " +
-                             test::shell_quote(out) + arguments);
-  };
+  const SphereUnderLimit sphere("memory-plan");
+  const Mesh& mesh = sphere.mesh;
+  const std::string report = sphere.scratch.file("r.json").string();
   const std::uint64_t first_limit = 700ull << 20;
-  const auto refused = cli_under(first_limit, "");
+  const auto refused = sphere.enhance(first_limit);
   ASSERT_EQ(refused.exit_code, 1) << refused.err;
   auto gib_before = [&](const std::string& words) {
     const auto end = refused.err.find(words);
@@ -123,9 +129,9 @@ TEST(CliMemoryLimit, WhereOnlyTheMultilevelPathWouldNotFitBlockJacobiRunsAndSays
       static_cast<double>(estimated_enhance_peak_bytes(mesh.num_vertices(), true, 0, LinearSolver::Iterative));
   const double own = static_cast<double>(first_limit) - available;  // the address space at the check
   const auto limit = static_cast<std::uint64_t>(own + (multilevel + block_jacobi) / 2 - held);
-  const auto r = cli_under(limit, " --report " + test::shell_quote(report));
+  const auto r = sphere.enhance(limit, " --report " + test::shell_quote(report));
   ASSERT_EQ(r.exit_code, 0) << "ulimit -v " << limit / 1024 << ": " << r.err;
-  const std::string start = "vertexflow: warning: " + big + ": the multilevel preconditioner would need about ";
+  const std::string start = "vertexflow: warning: " + sphere.path + ": the multilevel preconditioner would need about ";
   const auto line = r.err.find(start);
   ASSERT_NE(line, std::string::npos) << r.err;
   EXPECT_NE(r.err.find("so the flow runs block-Jacobi alone", line), std::string::npos) << r.err;
@@ -133,7 +139,7 @@ TEST(CliMemoryLimit, WhereOnlyTheMultilevelPathWouldNotFitBlockJacobiRunsAndSays
   EXPECT_EQ(j["options"]["solver"], "conjugate gradients");  // LinearSolver::Iterative by the plan
   EXPECT_EQ(j["solver"]["method"], "conjugate gradients");   // no multilevel
   EXPECT_NE(j["solver"]["chosen_for_memory"].get<std::string>().find("block-Jacobi alone"), std::string::npos);
-  EXPECT_TRUE(std::filesystem::exists(out));
+  EXPECT_TRUE(std::filesystem::exists(sphere.out));
 #endif
 }
 
