@@ -2,6 +2,7 @@
 // points, TBB for the parallel queries.
 #include "vertexflow/distance.h"
 
+#include "common/bucket_by_key.h"
 #include "numerics/vertex_ordering.h"
 
 #include <CGAL/AABB_traits.h>
@@ -199,22 +200,16 @@ void sort_along_morton_curve(Vertices& P, std::int64_t first, std::int64_t count
 // most of a sampling's 6 s).
 std::vector<std::uint64_t> sorted_edges(const Faces& F, Index nv) {
   const Index nf = static_cast<Index>(F.rows());
-  std::vector<std::int64_t> start(static_cast<std::size_t>(nv) + 1, 0);
-  for (Index f = 0; f < nf; ++f)
-    for (int k = 0; k < 3; ++k) {
-      const Index i = F(f, k), j = F(f, (k + 1) % 3);
-      if (i != j) ++start[static_cast<std::size_t>(std::min(i, j)) + 1];
-    }
-  for (std::size_t v = 0; v < static_cast<std::size_t>(nv); ++v) start[v + 1] += start[v];
-  std::vector<Index> larger(static_cast<std::size_t>(start.back()));
-  {
-    std::vector<std::int64_t> next(start.begin(), start.end() - 1);
-    for (Index f = 0; f < nf; ++f)
-      for (int k = 0; k < 3; ++k) {
-        const Index i = F(f, k), j = F(f, (k + 1) % 3);
-        if (i != j) larger[static_cast<std::size_t>(next[static_cast<std::size_t>(std::min(i, j))]++)] = std::max(i, j);
-      }
-  }
+  KeyBuckets<Index, std::int64_t> buckets =
+      bucket_by_key<Index, std::int64_t>(static_cast<std::size_t>(nv), [&](auto&& emit) {
+        for (Index f = 0; f < nf; ++f)
+          for (int k = 0; k < 3; ++k) {
+            const Index i = F(f, k), j = F(f, (k + 1) % 3);
+            if (i != j) emit(static_cast<std::size_t>(std::min(i, j)), std::max(i, j));
+          }
+      });
+  const std::vector<std::int64_t>& start = buckets.start;
+  std::vector<Index>& larger = buckets.items;
   // Each bucket sorted and made unique in place; its distinct count, then their offsets.
   std::vector<std::int64_t> distinct(static_cast<std::size_t>(nv) + 1, 0);
   tbb::parallel_for(tbb::blocked_range<Index>(0, nv, 4096), [&](const tbb::blocked_range<Index>& r) {
