@@ -91,48 +91,36 @@ std::uint64_t peak_resident_bytes() {
   return static_cast<std::uint64_t>(usage.ru_maxrss) * 1024;  // KiB on Linux
 }
 
-namespace {
-
-// The one line of InsufficientMemoryError if `solver`'s estimate, less what is held, exceeds
-// what is available; empty if it fits.
-std::string shortfall(const std::string& path, Index vertices, bool with_report, Index reference_vertices,
-                      LinearSolver solver, const AvailableMemory& available, std::uint64_t held) {
-  const std::uint64_t estimate = estimated_enhance_peak_bytes(vertices, with_report, reference_vertices, solver);
-  const std::uint64_t more = estimate > held ? estimate - held : 0;
-  if (more <= available.bytes) return {};
-  return fmt::format(
-      "{}: enhancing {} vertices{} needs about {:.2f} GiB at its peak (estimated from measured runs, "
-      "docs/benchmarks.md; {:.2f} GiB of it held already), but only {:.2f} GiB more is available ({})",
-      path, vertices, with_report ? " with a report" : "", gib(estimate), gib(held), gib(available.bytes),
-      available.limited_by);
-}
-
-}  // namespace
-
 EnhanceMemoryPlan plan_memory_for_enhance(const std::string& path, Index vertices, bool with_report,
                                           Index reference_vertices, LinearSolver solver,
                                           const std::optional<AvailableMemory>& available, std::uint64_t held) {
   EnhanceMemoryPlan plan{solver, {}};
   if (!available) return plan;
-  std::string refusal = shortfall(path, vertices, with_report, reference_vertices, solver, *available, held);
-  if (refusal.empty()) return plan;
+  const auto estimate = [&](LinearSolver s) {
+    return estimated_enhance_peak_bytes(vertices, with_report, reference_vertices, s);
+  };
+  const auto fits = [&](std::uint64_t bytes) { return (bytes > held ? bytes - held : 0) <= available->bytes; };
+  const std::uint64_t wanted = estimate(solver);
+  if (fits(wanted)) return plan;
+  std::uint64_t least = wanted;  // the estimate the refusal names: the lightest path allowed
   if (solver == LinearSolver::Automatic) {
     const LinearSolver lighter = LinearSolver::Iterative;
-    std::string lighter_refusal = shortfall(path, vertices, with_report, reference_vertices, lighter, *available, held);
-    if (lighter_refusal.empty()) {
+    least = estimate(lighter);
+    if (fits(least)) {
       plan.solver = lighter;
       plan.note = fmt::format(
           "the multilevel preconditioner would need about {:.2f} GiB at the peak ({:.2f} GiB of it held already), "
           "but only {:.2f} GiB more is available ({}), so the flow runs block-Jacobi alone (about {:.2f} GiB; slower "
           "on large flat regions)",
-          gib(estimated_enhance_peak_bytes(vertices, with_report, reference_vertices, solver)), gib(held),
-          gib(available->bytes), available->limited_by,
-          gib(estimated_enhance_peak_bytes(vertices, with_report, reference_vertices, lighter)));
+          gib(wanted), gib(held), gib(available->bytes), available->limited_by, gib(least));
       return plan;
     }
-    refusal = std::move(lighter_refusal);
   }
-  throw InsufficientMemoryError(refusal);
+  throw InsufficientMemoryError(
+      fmt::format("{}: enhancing {} vertices{} needs about {:.2f} GiB at its peak (estimated from measured runs, "
+                  "docs/benchmarks.md; {:.2f} GiB of it held already), but only {:.2f} GiB more is available ({})",
+                  path, vertices, with_report ? " with a report" : "", gib(least), gib(held), gib(available->bytes),
+                  available->limited_by));
 }
 
 EnhanceMemoryPlan plan_memory_for_enhance(const std::string& path, Index vertices, bool with_report,
