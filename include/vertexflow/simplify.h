@@ -1,9 +1,12 @@
 // Quadric-error simplification (Garland and Heckbert, "Surface simplification using quadric
 // error metrics", SIGGRAPH 1997): edges are collapsed in order of the summed squared distance of
 // the new vertex to the planes of the original faces around it, until a face budget is met.
-// The implementation is CGAL's Surface_mesh_simplification::edge_collapse with
-// GarlandHeckbert_plane_policies (cost and optimal placement); CGAL refuses collapses that
-// would change the topology or fold a face over.
+// Two implementations (SimplifyMethod), with the same quadrics, placement and stopping rule:
+// CGAL's Surface_mesh_simplification::edge_collapse with GarlandHeckbert_plane_policies (cost
+// and optimal placement), and vertexflow's own collapse on index arrays, which is about ten
+// times faster (docs/lod.md). Both refuse collapses that would change the topology or turn a
+// face over; they differ in how they test that (CGAL: the dihedral angle between the new
+// faces; Native: each face's normal before and after), so their meshes differ in detail.
 //
 // Conventions
 // - Face budget: the result has target or target + 1 faces. A collapse removes two faces (one
@@ -26,7 +29,21 @@
 #include "vertexflow/manifold_split.h"
 #include "vertexflow/mesh.h"
 
+#include <map>
+#include <string>
+
 namespace vertexflow {
+
+/// Which implementation collapses the edges (see above).
+enum class SimplifyMethod {
+  Cgal,    ///< CGAL's edge_collapse (the default of `simplify`)
+  Native,  ///< vertexflow's collapse on index arrays (the default of `lod`)
+};
+
+/// The methods by the names the CLI (`--method`) and Python (`method=`) take: "cgal", "native".
+const std::map<std::string, SimplifyMethod>& simplify_method_names();
+/// "cgal" or "native".
+std::string simplify_method_name(SimplifyMethod method);
 
 struct SimplifyOptions {
   /// Faces wanted in the result. 0 means: use target_ratio.
@@ -36,6 +53,7 @@ struct SimplifyOptions {
   double target_ratio = 0.1;
   /// Keep every boundary loop exactly (see above).
   bool keep_boundary = true;
+  SimplifyMethod method = SimplifyMethod::Cgal;
 };
 
 struct SimplifyReport {

@@ -11,12 +11,13 @@ namespace vertexflow::python {
 namespace {
 
 py::tuple py_simplify(const py::handle& V, const py::handle& F, Index faces, double ratio, bool keep_boundary,
-                      int threads) {
+                      const std::string& method, int threads) {
   const Mesh mesh = to_mesh(V, F);
   SimplifyOptions options;
   options.target_faces = faces;
   options.target_ratio = ratio;
   options.keep_boundary = keep_boundary;
+  options.method = enum_option("method", method, simplify_method_names());
   if (faces < 0) throw py::value_error("faces must be >= 0 (0: use ratio)");
   SimplifyResult r = without_gil(threads, [&] { return simplify(mesh.V, mesh.F, options); });
   return mesh_tuple(std::move(r.mesh));
@@ -61,8 +62,11 @@ py::tuple py_remesh(const py::handle& V, const py::handle& F, Index target_verti
 
 void register_remesh(py::module_& m) {
   m.def("simplify", &py_simplify, py::arg("V"), py::arg("F"), py::kw_only(), py::arg("faces") = 0,
-        py::arg("ratio") = SimplifyOptions{}.target_ratio, py::arg("keep_boundary") = true, py::arg("threads") = 0,
-        R"doc(QEM simplification to `faces` faces (or ratio * #F when faces is 0) -> (V, F).)doc");
+        py::arg("ratio") = SimplifyOptions{}.target_ratio, py::arg("keep_boundary") = true, py::arg("method") = "cgal",
+        py::arg("threads") = 0,
+        R"doc(QEM simplification to `faces` faces (or ratio * #F when faces is 0) -> (V, F). method:
+"cgal" (CGAL's edge collapse) or "native" (vertexflow's own: the same quadrics, several times
+faster), as `vertexflow simplify --method`.)doc");
   const IsotropicRemeshOptions isotropic;
   m.def("remesh", &py_remesh, py::arg("V"), py::arg("F"), py::kw_only(),
         py::arg("target_vertices") = RemeshOptions{}.target_vertices, py::arg("tolerance") = RemeshOptions{}.tolerance,

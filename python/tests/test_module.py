@@ -296,6 +296,12 @@ def test_compare_simplify_remesh_render():
     assert c["redistribution_rho"]["result"] > c["redistribution_rho"]["input"]
     Vs, Fs = vertexflow.simplify(V, F, faces=1000)
     assert abs(len(Fs) - 1000) <= 1 and Fs.max() < len(Vs)
+    # The native method (simplify.h): the same budget, other collapses; a wrong name is refused.
+    Vn, Fn = vertexflow.simplify(V, F, faces=1000, method="native")
+    assert abs(len(Fn) - 1000) <= 1 and Fn.max() < len(Vn)
+    assert len(Vn) != len(Vs) or not np.array_equal(Vn, Vs)
+    with pytest.raises(ValueError, match="method"):
+        vertexflow.simplify(V, F, faces=1000, method="fast")
     Vr, Fr = vertexflow.remesh(V, F, target_vertices=1500)
     assert abs(len(Vr) - 1500) <= 0.05 * 1500 + 1
     image = vertexflow.render(V, F, width=64, height=48, color="mean")

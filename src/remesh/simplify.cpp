@@ -1,7 +1,10 @@
 // Garland-Heckbert simplification through CGAL's edge-collapse framework (simplify.h).
 #include "vertexflow/simplify.h"
 
+#include "quadric_collapse.h"
 #include "surface_mesh_conversion.h"
+
+#include "vertexflow/topology.h"
 
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/Constrained_placement.h>
 #include <CGAL/Surface_mesh_simplification/Policies/Edge_collapse/GarlandHeckbert_plane_policies.h>
@@ -33,7 +36,49 @@ struct FaceBudget {
   }
 };
 
+// The Native method: the collapse on the manifold split of (V, F), then the CGAL path's repairs
+// only where its result needs them (none was needed on any mesh measured; kept so that the
+// output contract of simplify.h holds by construction, not by argument).
+Mesh simplify_native(const Vertices& V, const Faces& F, const SimplifyOptions& options, SimplifyReport& report) {
+  if (V.rows() == 0 || F.rows() == 0) throw std::invalid_argument("simplify: the mesh is empty");
+  // build_topology also checks the indices and repeated vertices.
+  const Topology topology = build_topology(F, static_cast<Index>(V.rows()));
+  ManifoldSplit copy;
+  const bool split = !(topology.is_manifold() && topology.is_oriented);
+  if (split) {
+    copy = split_non_manifold(V, F, topology);
+    report.repairs.input_split = copy.counts();
+  }
+  remesh_detail::QuadricCollapseResult collapsed = remesh_detail::quadric_collapse(
+      split ? copy.V : V, split ? copy.F : F, report.target_faces, options.keep_boundary);
+  report.collapses = collapsed.collapses;
+  Mesh& out = collapsed.mesh;
+  const Topology result = build_topology(out.F, out.num_vertices());
+  bool needs_repair = !(result.is_manifold() && result.is_oriented);
+  for (Index f = 0; f < out.num_faces() && !needs_repair; ++f) {
+    const Eigen::RowVector3d e1 = out.V.row(out.F(f, 1)) - out.V.row(out.F(f, 0));
+    const Eigen::RowVector3d e2 = out.V.row(out.F(f, 2)) - out.V.row(out.F(f, 0));
+    needs_repair = e1.cross(e2).squaredNorm() == 0;
+  }
+  if (!needs_repair) return std::move(out);
+  const ManifoldSplitCounts input_split = report.repairs.input_split;
+  SurfaceMesh mesh = remesh_detail::to_surface_mesh(out.V, out.F, "simplify");
+  Mesh repaired = remesh_detail::from_surface_mesh(mesh, &report.repairs);
+  report.repairs.input_split = input_split;
+  return repaired;
+}
+
 }  // namespace
+
+const std::map<std::string, SimplifyMethod>& simplify_method_names() {
+  static const std::map<std::string, SimplifyMethod> names{{"cgal", SimplifyMethod::Cgal},
+                                                           {"native", SimplifyMethod::Native}};
+  return names;
+}
+
+std::string simplify_method_name(SimplifyMethod method) {
+  return method == SimplifyMethod::Native ? "native" : "cgal";
+}
 
 SimplifyResult simplify(const Vertices& V, const Faces& F, const SimplifyOptions& options) {
   const auto start = std::chrono::steady_clock::now();
@@ -41,13 +86,20 @@ SimplifyResult simplify(const Vertices& V, const Faces& F, const SimplifyOptions
   if (options.target_faces == 0 && !(options.target_ratio > 0 && options.target_ratio <= 1))
     throw std::invalid_argument("simplify: the target ratio must be in (0, 1]");
   SimplifyReport report;
-  SurfaceMesh mesh = remesh_detail::to_surface_mesh(V, F, "simplify", &report.repairs.input_split);
-
   report.input_faces = static_cast<Index>(F.rows());
   report.target_faces =
       options.target_faces > 0
           ? options.target_faces
           : std::max<Index>(1, static_cast<Index>(std::lround(options.target_ratio * static_cast<double>(F.rows()))));
+  if (options.method == SimplifyMethod::Native) {
+    SimplifyResult result{simplify_native(V, F, options, report), {}};
+    report.output_faces = result.mesh.num_faces();
+    report.reached_target = report.output_faces <= report.target_faces + 1;
+    report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.report = report;
+    return result;
+  }
+  SurfaceMesh mesh = remesh_detail::to_surface_mesh(V, F, "simplify", &report.repairs.input_split);
   // Every collapse removes exactly one vertex (CGAL's return value counts removed edges).
   const auto vertices_before = mesh.number_of_vertices();
   if (report.target_faces < report.input_faces) {

@@ -4,6 +4,7 @@
 #include "test_support.h"
 
 #include "vertexflow/io.h"
+#include "vertexflow/simplify.h"
 #include "vertexflow/topology.h"
 
 #include <gtest/gtest.h>
@@ -59,6 +60,29 @@ TEST(CliSimplify, WritesTheBudgetAndASummary) {
   ASSERT_EQ(ratio.exit_code, 0) << ratio.err;
   EXPECT_TRUE(ratio.err.empty()) << ratio.err;
   EXPECT_EQ(read_mesh(half).num_faces(), 2928);
+}
+
+// --method native: the library's SimplifyMethod::Native (tests/remesh/test_simplify.cpp), same
+// bytes as the library's call, and named in the summary.
+TEST(CliSimplify, NativeMethodIsTheLibrarys) {
+  test::ScratchDir dir("cli-simplify-native");
+  const auto out = dir.file("camel.ply");
+  const auto r = run_cli("--quiet simplify " + quoted_data_path("camelhead.off") + " " + shell_quote(out.string()) +
+                         " --faces 3000 --method native --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["method"], "native");
+  const Mesh camel = read_mesh(test::data_path("camelhead.off"));
+  SimplifyOptions options;
+  options.target_faces = 3000;
+  options.method = SimplifyMethod::Native;
+  const Mesh expected = simplify(camel.V, camel.F, options).mesh;
+  const Mesh written = read_mesh(out);
+  EXPECT_EQ(written.F, expected.F);
+  EXPECT_EQ(written.V, expected.V);  // binary PLY: doubles kept
+  const auto bad = run_cli("simplify " + quoted_data_path("camelhead.off") + " " +
+                           shell_quote(dir.file("x.ply").string()) + " --faces 3000 --method fast");
+  EXPECT_NE(bad.exit_code, 0);
+  EXPECT_NE(bad.err.find("--method"), std::string::npos) << bad.err;
 }
 
 TEST(CliSimplify, BadInputFailsCleanly) {
