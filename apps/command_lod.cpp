@@ -31,6 +31,7 @@ struct LodCommandOptions {
   bool html = false;
   bool force = false;
   Index samples = SamplingOptions{}.samples;
+  SimplifyMethod simplify_method = LodOptions{}.simplify_method;
 };
 
 // "bunny" for "dir/bunny.off" and "dir/bunny.off.gz".
@@ -55,7 +56,7 @@ bool same_run(const nlohmann::json& old_summary, const nlohmann::json& summary) 
     if (!old_summary.contains(key) || old_summary[key] != summary[key]) return false;
   const nlohmann::json& a = old_summary.value("options", nlohmann::json::object());
   const nlohmann::json& b = summary["options"];
-  for (const char* key : {"edge_flips", "keep_boundary", "keep_better_of_two", "sampling"})
+  for (const char* key : {"edge_flips", "keep_boundary", "keep_better_of_two", "sampling", "simplify_method"})
     if (!a.contains(key) || a[key] != b[key]) return false;
   return true;
 }
@@ -165,6 +166,12 @@ void register_lod_command(CLI::App& app, const GlobalOptions& global) {
   budget->require_option(0, 1);
   command->add_flag("--edge-flips", o->edge_flips, "After each fit, flip edges towards DENSE and refit");
   command->add_flag("--free-boundary", o->free_boundary, "Let boundary edges collapse and boundary vertices move");
+  command
+      ->add_option("--simplify-method", o->simplify_method,
+                   "QEM of each level: native (default; vertexflow's own) or cgal (CGAL's edge collapse), the same "
+                   "quadrics")
+      ->transform(CLI::CheckedTransformer(simplify_method_names(), CLI::ignore_case))
+      ->default_str("native");
   command->add_flag("--keep-worse-fit", o->keep_worse_fit,
                     "Keep the fitted level even where QEM alone measures a smaller mean distance");
   command->add_option("--format", o->format, "Format of the level meshes (default: DENSE's)")
@@ -182,6 +189,7 @@ void register_lod_command(CLI::App& app, const GlobalOptions& global) {
     options.edge_flips = o->edge_flips;
     options.keep_boundary = !o->free_boundary;
     options.keep_better_of_two = !o->keep_worse_fit;
+    options.simplify_method = o->simplify_method;
     options.sampling.samples = o->samples;
 
     // The levels' order and ranges before anything is read (the counts need DENSE's faces).

@@ -10,9 +10,13 @@
 //       data/bunny.off data/amo.off data/armadillo-43k.obj data/horse-48k.ply data/rocker-arm.obj
 //       data/camelhead.off
 //
+// Also measured: vertexflow's own QEM (SimplifyMethod::Native, lod's default) directly at each
+// level, against CGAL's.
+//
 // Options: --levels 50,25,10,5,2,1 (percent); --no-flips (skip lod with flips); --samples N
 // (area samples per distance, default 200000); --fit-fairness W, --fit-proximity W,
-// --fit-tolerance T, --fit-rounds N, --fit-samples S (FitOptions, to explore the fit's weights).
+// --fit-tolerance T, --fit-rounds N, --fit-samples S (FitOptions, to explore the fit's weights);
+// --simplify-method native|cgal (the chain's QEM, LodOptions::simplify_method).
 #include "vertexflow/io.h"
 #include "vertexflow/lod.h"
 #include "vertexflow/simplify.h"
@@ -107,6 +111,8 @@ int main(int argc, char** argv) {
       json_path = next();
     else if (arg == "--markdown")
       markdown_path = next();
+    else if (arg == "--simplify-method")
+      options.simplify_method = simplify_method_names().at(next());
     else if (arg == "--fit-fairness")
       options.fit.fairness = std::stod(next());
     else if (arg == "--fit-proximity")
@@ -143,6 +149,10 @@ int main(int argc, char** argv) {
         const Mesh qem = simplify(dense_mesh.V, dense_mesh.F, so).mesh;
         row["cgal_qem"] = measured(qem, dense, options.sampling, seconds_since(start));
         start = Clock::now();
+        so.method = SimplifyMethod::Native;
+        const Mesh native = simplify(dense_mesh.V, dense_mesh.F, so).mesh;
+        row["native_qem"] = measured(native, dense, options.sampling, seconds_since(start));
+        start = Clock::now();
         const Mesh mo = meshopt_to(dense_mesh, budgets[i], true);
         row["meshoptimizer"] = measured(mo, dense, options.sampling, seconds_since(start));
         rows.push_back(std::move(row));
@@ -171,11 +181,12 @@ int main(int argc, char** argv) {
       }
       std::cerr << fmt::format("lod_peers: {} done\n", path);
       for (const auto& row : rows) {
-        std::cerr << fmt::format("  {:>5g}% {:>7}: cgal {:.4g} meshopt {:.4g} lod {:.4g} ({:+.1f}% vs cgal)",
-                                 row["percent"].get<double>(), row["target_faces"].get<Index>(),
-                                 row["cgal_qem"]["mean"].get<double>(), row["meshoptimizer"]["mean"].get<double>(),
-                                 row["lod"]["mean"].get<double>(),
-                                 100 * (row["lod"]["mean"].get<double>() / row["cgal_qem"]["mean"].get<double>() - 1));
+        std::cerr << fmt::format(
+            "  {:>5g}% {:>7}: cgal {:.4g} native {:.4g} meshopt {:.4g} lod {:.4g} ({:+.1f}% vs cgal)",
+            row["percent"].get<double>(), row["target_faces"].get<Index>(), row["cgal_qem"]["mean"].get<double>(),
+            row["native_qem"]["mean"].get<double>(), row["meshoptimizer"]["mean"].get<double>(),
+            row["lod"]["mean"].get<double>(),
+            100 * (row["lod"]["mean"].get<double>() / row["cgal_qem"]["mean"].get<double>() - 1));
         if (row.contains("lod_flips"))
           std::cerr << fmt::format(
               " flips {:.4g} ({:+.1f}%)", row["lod_flips"]["mean"].get<double>(),
@@ -219,7 +230,7 @@ int main(int argc, char** argv) {
                : std::string("-");
   };
   struct Sums {
-    double lod_qem = 0, flips_qem = 0, lod_mo = 0, flips_mo = 0, worst = -1;
+    double lod_qem = 0, flips_qem = 0, lod_mo = 0, flips_mo = 0, native_qem = 0, worst = -1;
     int n = 0, n_flips = 0;
   };
   Sums total;
@@ -242,6 +253,7 @@ int main(int argc, char** argv) {
       const double qem = row["cgal_qem"]["mean"], mo = row["meshoptimizer"]["mean"], l = row["lod"]["mean"];
       s.lod_qem += l / qem;
       s.lod_mo += l / mo;
+      s.native_qem += row["native_qem"]["mean"].get<double>() / qem;
       s.worst = std::max(s.worst, l / qem - 1);
       ++s.n;
       if (row.contains("lod_flips")) {
@@ -254,6 +266,7 @@ int main(int argc, char** argv) {
     per_mesh.emplace_back(mesh["name"].get<std::string>(), s);
     total.lod_qem += s.lod_qem;
     total.lod_mo += s.lod_mo;
+    total.native_qem += s.native_qem;
     total.flips_qem += s.flips_qem;
     total.flips_mo += s.flips_mo;
     total.worst = std::max(total.worst, s.worst);
@@ -262,12 +275,13 @@ int main(int argc, char** argv) {
   }
   md << "\nMean distance averaged over the levels from 50% to 2% (the mean of the per-level ratios, minus 1):\n\n"
      << "| mesh | lod vs CGAL QEM | lod + flips vs CGAL QEM | lod vs meshopt | lod + flips vs meshopt | lod's worst "
-        "level vs CGAL QEM |\n|---|---:|---:|---:|---:|---:|\n";
+        "level vs CGAL QEM | native QEM alone vs CGAL QEM |\n|---|---:|---:|---:|---:|---:|---:|\n";
   auto pct = [](double sum, int n) { return n ? fmt::format("{:+.1f}%", 100 * (sum / n - 1)) : std::string("-"); };
   per_mesh.emplace_back("all", total);
   for (const auto& [name, s] : per_mesh)
-    md << fmt::format("| {} | {} | {} | {} | {} | {:+.1f}% |\n", name, pct(s.lod_qem, s.n), pct(s.flips_qem, s.n_flips),
-                      pct(s.lod_mo, s.n), pct(s.flips_mo, s.n_flips), 100 * s.worst);
+    md << fmt::format("| {} | {} | {} | {} | {} | {:+.1f}% | {} |\n", name, pct(s.lod_qem, s.n),
+                      pct(s.flips_qem, s.n_flips), pct(s.lod_mo, s.n), pct(s.flips_mo, s.n_flips), 100 * s.worst,
+                      pct(s.native_qem, s.n));
   std::cout << md.str();
   if (!json_path.empty()) std::ofstream(json_path) << all.dump(1) << "\n";
   if (!markdown_path.empty()) std::ofstream(markdown_path) << md.str();

@@ -12,7 +12,7 @@ namespace {
 
 py::list py_lod(const py::handle& V, const py::handle& F, const std::vector<double>& levels,
                 const std::optional<std::vector<Index>>& faces, bool edge_flips, bool keep_boundary,
-                bool keep_better_of_two, Index samples, int threads) {
+                bool keep_better_of_two, Index samples, const std::string& simplify_method, int threads) {
   const Mesh dense = to_mesh(V, F);
   LodOptions options;
   options.percent = levels;
@@ -20,6 +20,7 @@ py::list py_lod(const py::handle& V, const py::handle& F, const std::vector<doub
   options.edge_flips = edge_flips;
   options.keep_boundary = keep_boundary;
   options.keep_better_of_two = keep_better_of_two;
+  options.simplify_method = enum_option("simplify_method", simplify_method, simplify_method_names());
   if (samples < 0) throw py::value_error("samples must be >= 0");
   options.sampling.samples = samples;
   std::vector<LodLevel> result = without_gil(threads, [&] { return lod(dense, options); });
@@ -37,12 +38,14 @@ py::list py_lod(const py::handle& V, const py::handle& F, const std::vector<doub
 void register_lod(py::module_& m) {
   m.def("lod", &py_lod, py::arg("V"), py::arg("F"), py::kw_only(), py::arg("levels") = LodOptions{}.percent,
         py::arg("faces") = py::none(), py::arg("edge_flips") = false, py::arg("keep_boundary") = true,
-        py::arg("keep_better_of_two") = true, py::arg("samples") = SamplingOptions{}.samples, py::arg("threads") = 0,
+        py::arg("keep_better_of_two") = true, py::arg("samples") = SamplingOptions{}.samples,
+        py::arg("simplify_method") = "native", py::arg("threads") = 0,
         R"doc(Levels of detail of the dense mesh (V, F), as `vertexflow lod` makes them (lod.h,
 docs/lod.md): for each level, QEM from the level before, then reference mode's fit against (V, F)
 (and edge flips with refits when edge_flips), keeping QEM alone where the fit measures a larger
 mean distance (unless keep_better_of_two is False). levels: percent of F's faces, strictly
 decreasing; faces: face counts instead. samples: area samples per distance measurement.
+simplify_method: "native" or "cgal", the QEM of each level (`vertexflow lod --simplify-method`).
 Returns a list of (V, F, report), finest first; report holds the level's faces, the two-sided
 mean, RMS and Hausdorff distance to (V, F) for QEM alone ("qem") and the fitted level ("fitted"),
 which was kept, the minimum quality, flipped faces and seconds, as the CLI's summary does.)doc");

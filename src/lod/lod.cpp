@@ -94,6 +94,7 @@ LodLevel lod_level(const Mesh& previous, const ReferenceSurface& dense, Index ta
   SimplifyOptions so;
   so.target_faces = target_faces;
   so.keep_boundary = options.keep_boundary;
+  so.method = options.simplify_method;
   report_progress("simplify", 0, 0.35);
   SimplifyResult qem = simplify(previous.V, previous.F, so);
   r.simplify = qem.report;
@@ -169,6 +170,7 @@ nlohmann::json lod_options_json(const LodOptions& options) {
     j["faces"] = options.faces;
   j["edge_flips"] = options.edge_flips;
   j["keep_boundary"] = options.keep_boundary;
+  j["simplify_method"] = simplify_method_name(options.simplify_method);
   j["keep_better_of_two"] = options.keep_better_of_two;
   j["sampling"] = {{"samples", options.sampling.samples},
                    {"seed", options.sampling.seed},
