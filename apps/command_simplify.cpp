@@ -37,8 +37,8 @@ void register_simplify_command(CLI::App& app, const GlobalOptions& global) {
   command->add_flag("--free-boundary", o->free_boundary, "Let boundary edges collapse and boundary vertices move");
   command
       ->add_option("--method", o->simplify.method,
-                   "cgal: CGAL's edge collapse (default); native: vertexflow's own, same quadrics, about ten "
-                   "times faster")
+                   "cgal: CGAL's edge collapse (default); native: vertexflow's own, area-weighted quadrics, "
+                   "about three times faster")
       ->transform(CLI::CheckedTransformer(simplify_method_names(), CLI::ignore_case))
       ->default_str("cgal");
   command->add_flag("--json", o->json, "Print a summary as JSON on stdout");

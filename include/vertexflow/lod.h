@@ -59,8 +59,9 @@ struct LodOptions {
   bool edge_flips = false;
   /// simplify.h's keep_boundary; false also lets the fit move boundary vertices.
   bool keep_boundary = true;
-  /// The QEM of every level (simplify.h). Native by default: the same quadrics as CGAL's at a
-  /// fraction of the time (the 1M-vertex chain: docs/lod.md).
+  /// The QEM of every level (simplify.h). Native by default: its area-weighted quadrics keep
+  /// the chain closer to D (a fitted level's faces differ in size), at a fraction of CGAL's
+  /// time (docs/lod.md).
   SimplifyMethod simplify_method = SimplifyMethod::Native;
   /// Keep QEM alone at a level where the fit measures a larger two-sided mean distance (above).
   bool keep_better_of_two = true;

@@ -65,7 +65,7 @@ void register_remesh(py::module_& m) {
         py::arg("ratio") = SimplifyOptions{}.target_ratio, py::arg("keep_boundary") = true, py::arg("method") = "cgal",
         py::arg("threads") = 0,
         R"doc(QEM simplification to `faces` faces (or ratio * #F when faces is 0) -> (V, F). method:
-"cgal" (CGAL's edge collapse) or "native" (vertexflow's own: the same quadrics, several times
+"cgal" (CGAL's edge collapse) or "native" (vertexflow's own: area-weighted quadrics, several times
 faster), as `vertexflow simplify --method`.)doc");
   const IsotropicRemeshOptions isotropic;
   m.def("remesh", &py_remesh, py::arg("V"), py::arg("F"), py::kw_only(),

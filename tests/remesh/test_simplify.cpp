@@ -207,12 +207,13 @@ TEST_P(Simplify, RefusesBadOptions) {
   EXPECT_THROW(simplify(Vertices(), Faces()), std::invalid_argument);
 }
 
-// The native collapse shares CGAL's quadrics and placement, so its meshes are as close to the
-// dense surface. Measured on bunny.off (two-sided mean distance, lod.h's measurement), native
-// over CGAL: 0.997 at 10%, 0.986 at 2%, 1.016 at 1% (bench/lod_peers gives the same on five more
-// meshes, docs/lod.md). A collapse in any other order, or a worse placement, measures 1.3-1.7
-// times CGAL's (meshoptimizer, which keeps input positions: 1.59 and 1.63 here).
-TEST(SimplifyNative, IsAsCloseToTheDenseMeshAsCgal) {
+// The native collapse shares CGAL's placement and weights its quadrics by area, so its meshes
+// are at least as close to the dense surface. Measured on bunny.off (two-sided mean distance,
+// lod.h's measurement), native over CGAL: 0.974 at 10%, 0.953 at 2% (bench/lod_peers: 0.76-1.00
+// on five more meshes, averaged over 50-2%, docs/lod.md). A collapse in any other order, or a
+// worse placement, measures 1.3-1.7 times CGAL's (meshoptimizer, which keeps input positions:
+// 1.59 and 1.63 here).
+TEST(SimplifyNative, IsAtLeastAsCloseToTheDenseMeshAsCgal) {
   const Mesh bunny = read_mesh(test::data_path("bunny.off"));
   const ReferenceSurface dense(bunny.V, bunny.F);
   for (const Index target : {6967, 1393}) {
@@ -224,8 +225,8 @@ TEST(SimplifyNative, IsAsCloseToTheDenseMeshAsCgal) {
     const double ours = lod_distance(native.mesh, dense).mean;
     std::cout << "[measured] bunny.off to " << target << " faces: mean distance native / CGAL " << ours / cgal << "\n";
     EXPECT_LE(native.mesh.num_faces(), target + 1);
-    EXPECT_LT(ours, 1.05 * cgal);
-    EXPECT_GT(ours, 0.9 * cgal);  // not better by much either: the same quadrics
+    EXPECT_LT(ours, 0.995 * cgal);
+    EXPECT_GT(ours, 0.85 * cgal);  // not better by much either: the same planes, other weights
   }
 }
 
