@@ -48,9 +48,11 @@ TEST(LodBudgets, PercentAndFacesAndTheirErrors) {
 // max-planck-5k (a real head scan at the paper's resolution, 10,540 faces): every level within one
 // face of its budget and below the one before, no face turned over by the fit, and the fit closer
 // to the dense mesh than QEM alone at every level. Measured mean gains (1 - fitted / QEM) at 50%,
-// 20%, 5%: 10.7%, 15.8%, 21.8%; the bounds are about half of them.
+// 20%, 5%: 2.9%, 8.2%, 14.0% over the chain's own QEM (the native one, whose area weights
+// already keep the chain closer: with CGAL's QEM in the chain the gains were 9.4%, 15.6%, 21.0%
+// and the fitted levels 13%, 11% and 8% farther from the dense mesh); the bounds are about half.
 TEST(Lod, LevelsAreMonotoneUnflippedAndCloserThanQem) {
-  constexpr double kMinGain[] = {0.05, 0.08, 0.10};
+  constexpr double kMinGain[] = {0.015, 0.04, 0.07};
   const Mesh dense = read_mesh(test::data_path("max-planck-5k.obj"));
   const LodOptions options = quick({50, 20, 5});
   const std::vector<Index> budgets = lod_face_budgets(dense.num_faces(), options);
