@@ -348,19 +348,30 @@ nlohmann::json flip_and_refit(const Mesh& input, const ReferenceSurface* referen
     nlohmann::json entry = {
         {"flips", r.flips}, {"passes", r.passes}, {"rms_before", r.rms_before}, {"rms_after_flips", r.rms_after}};
     total += r.flips;
+    bool refit_refused = false;
     if (r.flips > 0) {
       out.F = std::move(flipped.F);
       if (fit) {
         const ProgressPart refit_part("refit", 0.5, 1);
-        out.V = fit_to_reference(out.V, out.F, *reference, refit).V;
-        entry["refitted"] = true;
+        Vertices refitted = fit_to_reference(out.V, out.F, *reference, refit).V;
+        // The refit's guard keeps each face from turning against its own start, the flipped
+        // mesh, not against the input face whose index it took: a steep new face could still
+        // end past 90 degrees from that one (one face at a level of horse-48k and of rocker-arm
+        // in bench/lod_peers). Such a refit is not taken, and the cycles stop.
+        const Index turned = faces_turned_over(input.V, input.F, refitted, out.F);
+        refit_refused = turned > 0;
+        if (refit_refused)
+          entry["refit_refused_turned_faces"] = turned;
+        else
+          out.V = std::move(refitted);
+        entry["refitted"] = !refit_refused;
       }
     }
     tell(callbacks.phase,
          fmt::format("edge flips, cycle {}: {} flips in {} passes, RMS distance to the {} {:.6g} -> {:.6g}", cycle + 1,
                      r.flips, r.passes, fit ? "reference" : "smooth estimate", r.rms_before, r.rms_after));
     cycles.push_back(std::move(entry));
-    if (r.flips == 0 || !fit) break;
+    if (r.flips == 0 || !fit || refit_refused) break;
   }
   return {{"cycles", cycles},
           {"flips", total},
