@@ -168,8 +168,8 @@ void register_lod_command(CLI::App& app, const GlobalOptions& global) {
   command->add_flag("--free-boundary", o->free_boundary, "Let boundary edges collapse and boundary vertices move");
   command
       ->add_option("--simplify-method", o->simplify_method,
-                   "QEM of each level: native (default; vertexflow's own) or cgal (CGAL's edge collapse), the same "
-                   "quadrics")
+                   "QEM of each level: native (default; vertexflow's own, area-weighted quadrics) or cgal (CGAL's "
+                   "edge collapse)")
       ->transform(CLI::CheckedTransformer(simplify_method_names(), CLI::ignore_case))
       ->default_str("native");
   command->add_flag("--keep-worse-fit", o->keep_worse_fit,

@@ -1,4 +1,5 @@
-// Garland-Heckbert simplification through CGAL's edge-collapse framework (simplify.h).
+// Garland-Heckbert simplification (simplify.h): through CGAL's edge-collapse framework, or
+// vertexflow's own collapse (quadric_collapse.h).
 #include "vertexflow/simplify.h"
 
 #include "quadric_collapse.h"
@@ -36,6 +37,37 @@ struct FaceBudget {
   }
 };
 
+// The Cgal method: CGAL's edge_collapse with Garland-Heckbert quadrics on a Surface_mesh.
+Mesh simplify_cgal(const Vertices& V, const Faces& F, const SimplifyOptions& options, SimplifyReport& report) {
+  SurfaceMesh mesh = remesh_detail::to_surface_mesh(V, F, "simplify", &report.repairs.input_split);
+  // Every collapse removes exactly one vertex (CGAL's return value counts removed edges).
+  const auto vertices_before = mesh.number_of_vertices();
+  if (report.target_faces < report.input_faces) {
+    const FaceBudget stop{static_cast<std::size_t>(report.target_faces)};
+    Quadrics quadrics(mesh);
+    // A closed mesh has nothing to constrain: the unconstrained call collapses the same edges
+    // to the same places, and skips Constrained_placement's walk around both ends of every
+    // edge costed (15% of the run on a closed 1M-vertex mesh, measured with perf).
+    const bool constrain_boundary = options.keep_boundary && std::any_of(mesh.edges().begin(), mesh.edges().end(),
+                                                                         [&](auto e) { return mesh.is_border(e); });
+    if (constrain_boundary) {
+      // Boundary edges are constrained: never collapsed, and Constrained_placement puts any
+      // collapse that touches a boundary vertex onto that vertex, so the loops stay exact.
+      auto on_boundary = mesh.add_property_map<SurfaceMesh::Edge_index, bool>("e:vertexflow_boundary", false).first;
+      for (const auto e : mesh.edges()) on_boundary[e] = mesh.is_border(e);
+      const SMS::Constrained_placement<Quadrics, decltype(on_boundary)> placement(on_boundary, quadrics);
+      SMS::edge_collapse(
+          mesh, stop,
+          CGAL::parameters::edge_is_constrained_map(on_boundary).get_cost(quadrics).get_placement(placement));
+    } else {
+      SMS::edge_collapse(mesh, stop, CGAL::parameters::get_cost(quadrics).get_placement(quadrics));
+    }
+  }
+
+  report.collapses = static_cast<Index>(vertices_before - mesh.number_of_vertices());
+  return remesh_detail::from_surface_mesh(mesh, &report.repairs);
+}
+
 // The Native method: the collapse on the manifold split of (V, F), then the CGAL path's repairs
 // only where its result needs them (none was needed on any mesh measured; kept so that the
 // output contract of simplify.h holds by construction, not by argument).
@@ -59,11 +91,8 @@ Mesh simplify_native(const Vertices& V, const Faces& F, const SimplifyOptions& o
   Mesh& out = collapsed.mesh;
   const Topology result = build_topology(out.F, out.num_vertices());
   bool needs_repair = !(result.is_manifold() && result.is_oriented);
-  for (Index f = 0; f < out.num_faces() && !needs_repair; ++f) {
-    const Eigen::RowVector3d e1 = out.V.row(out.F(f, 1)) - out.V.row(out.F(f, 0));
-    const Eigen::RowVector3d e2 = out.V.row(out.F(f, 2)) - out.V.row(out.F(f, 0));
-    needs_repair = e1.cross(e2).squaredNorm() == 0;
-  }
+  for (Index f = 0; f < out.num_faces() && !needs_repair; ++f)
+    needs_repair = face_normal(out.V, out.F, f).squaredNorm() == 0;
   if (!needs_repair) return std::move(out);
   const ManifoldSplitCounts input_split = report.repairs.input_split;
   SurfaceMesh mesh = remesh_detail::to_surface_mesh(out.V, out.F, "simplify");
@@ -95,41 +124,9 @@ SimplifyResult simplify(const Vertices& V, const Faces& F, const SimplifyOptions
       options.target_faces > 0
           ? options.target_faces
           : std::max<Index>(1, static_cast<Index>(std::lround(options.target_ratio * static_cast<double>(F.rows()))));
-  if (options.method == SimplifyMethod::Native) {
-    SimplifyResult result{simplify_native(V, F, options, report), {}};
-    report.output_faces = result.mesh.num_faces();
-    report.reached_target = report.output_faces <= report.target_faces + 1;
-    report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    result.report = report;
-    return result;
-  }
-  SurfaceMesh mesh = remesh_detail::to_surface_mesh(V, F, "simplify", &report.repairs.input_split);
-  // Every collapse removes exactly one vertex (CGAL's return value counts removed edges).
-  const auto vertices_before = mesh.number_of_vertices();
-  if (report.target_faces < report.input_faces) {
-    const FaceBudget stop{static_cast<std::size_t>(report.target_faces)};
-    Quadrics quadrics(mesh);
-    // A closed mesh has nothing to constrain: the unconstrained call collapses the same edges
-    // to the same places, and skips Constrained_placement's walk around both ends of every
-    // edge costed (15% of the run on a closed 1M-vertex mesh, measured with perf).
-    const bool constrain_boundary = options.keep_boundary && std::any_of(mesh.edges().begin(), mesh.edges().end(),
-                                                                         [&](auto e) { return mesh.is_border(e); });
-    if (constrain_boundary) {
-      // Boundary edges are constrained: never collapsed, and Constrained_placement puts any
-      // collapse that touches a boundary vertex onto that vertex, so the loops stay exact.
-      auto on_boundary = mesh.add_property_map<SurfaceMesh::Edge_index, bool>("e:vertexflow_boundary", false).first;
-      for (const auto e : mesh.edges()) on_boundary[e] = mesh.is_border(e);
-      const SMS::Constrained_placement<Quadrics, decltype(on_boundary)> placement(on_boundary, quadrics);
-      SMS::edge_collapse(
-          mesh, stop,
-          CGAL::parameters::edge_is_constrained_map(on_boundary).get_cost(quadrics).get_placement(placement));
-    } else {
-      SMS::edge_collapse(mesh, stop, CGAL::parameters::get_cost(quadrics).get_placement(quadrics));
-    }
-  }
-
-  report.collapses = static_cast<Index>(vertices_before - mesh.number_of_vertices());
-  SimplifyResult result{remesh_detail::from_surface_mesh(mesh, &report.repairs), {}};
+  SimplifyResult result{options.method == SimplifyMethod::Native ? simplify_native(V, F, options, report)
+                                                                 : simplify_cgal(V, F, options, report),
+                        {}};
   report.output_faces = result.mesh.num_faces();
   report.reached_target = report.output_faces <= report.target_faces + 1;
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
