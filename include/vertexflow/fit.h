@@ -44,6 +44,25 @@
 
 namespace vertexflow {
 
+/// How a fit solves each round's linear system (src/fit/fit_system.h explains both). They
+/// minimise the same energy and differ by rounding only: on the remeshes of data/ the RMS
+/// distances of the two agree to 12 digits (docs/benchmarks.md, "Fit solvers").
+enum class FitSolver {
+  /// Conjugate gradients on each round's step, block-Jacobi preconditioned, to a relative
+  /// residual of kFitIterativeTolerance (about 20 iterations a round on every mesh measured);
+  /// the direct solve takes over a round whose iteration has not converged within
+  /// kFitMaxIterations. Faster than Direct at every size measured (4.5k to 500k vertices).
+  Iterative,
+  /// CHOLMOD's sparse Cholesky factorisation. Its fill-reducing ordering and factorisation grow
+  /// faster than the mesh: 5.2 s and 3.6 s for 346k vertices.
+  Direct,
+};
+
+/// The relative residual |b - A d| / |b| at which the iterative solve of a round's step stops.
+inline constexpr double kFitIterativeTolerance = 1e-10;
+/// Iterations of one round's iterative solve before the direct solve takes over.
+inline constexpr int kFitMaxIterations = 1000;
+
 struct FitOptions {
   /// Area-uniform samples of the reference per vertex of the mesh. Measured on a 6k remesh of
   /// bunny.off: 10 gives a mean distance within 0.5% of 20's (-45.4% and -45.8% of the
@@ -74,6 +93,8 @@ struct FitOptions {
   /// of the measurement's, so a fit was scored partly on its own data points (amo's lod gain
   /// over QEM: -11.5% measured that way, -10.5% with the fit on another stream).
   std::uint64_t seed = 1;
+  /// How each round's linear system is solved (FitSolver).
+  FitSolver solver = FitSolver::Iterative;
 };
 
 /// The seed of the stream the fit draws its samples of the reference from, for FitOptions::seed:
@@ -94,6 +115,10 @@ struct FitReport {
   /// Wall-clock seconds: seconds_tree is the reference's tree, built alongside its samples and
   /// the ordering and analysis of the linear system; the others sum over the rounds.
   double seconds_tree = 0, seconds_queries = 0, seconds_solve = 0, seconds_guard = 0;
+  /// The conjugate-gradient iterations summed over the rounds (0 for FitSolver::Direct), and
+  /// the rounds whose iteration did not converge and were solved directly instead.
+  int solver_iterations = 0;
+  int solver_fallbacks = 0;
   /// Smooth mode: building the patches (0 in reference mode); seconds_tree is then the
   /// system's set-up.
   double seconds_surface = 0;

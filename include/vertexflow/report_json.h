@@ -30,6 +30,7 @@ void to_json(nlohmann::json& j, FairnessTarget target);
 /// "automatic", "direct (CHOLMOD)", "conjugate gradients" (Iterative) or "conjugate gradients,
 /// multilevel" (Multilevel).
 void to_json(nlohmann::json& j, LinearSolver solver);
+void to_json(nlohmann::json& j, FitSolver solver);
 
 /// "max1999", "area" or "angle".
 void to_json(nlohmann::json& j, NormalWeighting weighting);

@@ -455,6 +455,8 @@ SmoothFitOptions effective_smooth_options(const EnhanceOptions& o, bool already_
   smooth.surface.feature_angle = o.feature_angle;
   smooth.fit.constraints = o.constraints;
   smooth.fit.guard = o.guard;
+  // The solver is one choice for both fits (the option table's fit_solver).
+  smooth.fit.solver = o.fit.solver;
   if (o.max_rounds) smooth.fit.max_rounds = *o.max_rounds;
   if (o.assume_on_surface) smooth.max_poor_face_fraction = smooth.max_sharp_edge_fraction = 1.0;
   smooth.already_fitted = already_fitted && !o.assume_on_surface;

@@ -276,6 +276,12 @@ std::vector<EnhanceOptionSpec> make_specs() {
                          "Reference mode: area-uniform samples of the reference per vertex of the mesh",
                          [](auto& o) -> auto& { return o.fit.samples_per_vertex; }),
                      0, kInf, true, true));
+  t.push_back(choice<FitSolver>(member_spec(
+                                    "fit_solver", "fit.solver", "--fit-solver", K::Choice, kFit | kSmooth,
+                                    "Reference and smooth modes: how each round's linear system is "
+                                    "solved: iterative (conjugate gradients) or direct (CHOLMOD); fit.h",
+                                    [](auto& o) -> auto& { return o.fit.solver; }),
+                                {{"iterative", FitSolver::Iterative}, {"direct", FitSolver::Direct}}));
   t.push_back(ranged(member_spec(
                          "smooth_segments", "smooth.surface.segments", "--smooth-segments", K::Int, kSmooth,
                          "Smooth mode: each face of the estimate is tessellated into this squared triangles",

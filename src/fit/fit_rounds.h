@@ -1,8 +1,8 @@
-// Internal to the fit stage: the linear system and the rounds that reference mode and smooth
-// mode share (fit.h): data rows, the energy's solve on a fixed pattern, and the guard (guard.h)
-// after every solve.
+// Internal to the fit stage: the rounds that reference mode and smooth mode share (fit.h): the
+// solve of the round's linear system (fit_system.h), then the guard (guard.h).
 #pragma once
 
+#include "fit_system.h"
 #include "vertexflow/fit.h"
 #include "vertexflow/guard.h"
 #include "vertexflow/topology.h"
@@ -16,21 +16,9 @@ namespace vertexflow {
 
 struct GuardCriteria;
 
-/// A point of the mesh as a combination of (up to) three vertices, and the point of the other
-/// surface it should reach.
-struct DataRow {
-  Index face = -1;  ///< the face whose corners these are; -1 for a vertex (corners all equal)
-  Eigen::Vector3i corners;
-  Eigen::Vector3d weights;
-  Eigen::Vector3d target;
-  double weight = 1.0;  ///< relative to the other rows of its direction
-};
-
 /// Throws std::invalid_argument, its message starting with `context`, for an empty mesh, a
 /// non-finite coordinate, or options out of range (fit.h's fit_to_reference).
 void validate_fit(const Vertices& V, const Faces& F, const FitOptions& options, const std::string& context);
-
-class FitSystem;
 
 /// The state of a fit's rounds: which vertices are fixed (boundary unless
 /// options.constraints.fix_boundary is false, pins, vertices without faces), the system, and the guard.

@@ -30,6 +30,10 @@ void to_json(nlohmann::json& j, LinearSolver solver) {
   j = "?";
 }
 
+void to_json(nlohmann::json& j, FitSolver solver) {
+  j = choice_name("fit_solver", static_cast<long long>(solver));
+}
+
 void to_json(nlohmann::json& j, NormalWeighting weighting) {
   j = choice_name("normal_weighting", static_cast<long long>(weighting));
 }
@@ -126,7 +130,8 @@ void to_json(nlohmann::json& j, const FitOptions& options) {
        {"crease_edges", options.constraints.crease_edges.size()},
        {"min_quality", options.guard.min_quality},
        {"sliver_floor", options.guard.sliver_floor},
-       {"seed", options.seed}};
+       {"seed", options.seed},
+       {"solver", options.solver}};
 }
 
 void to_json(nlohmann::json& j, const FitReport& report) {
@@ -135,6 +140,7 @@ void to_json(nlohmann::json& j, const FitReport& report) {
          {"rounds", report.rounds},
          {"converged", report.converged},
          {"reference_samples", report.reference_samples}}},
+       {"solver", {{"iterations", report.solver_iterations}, {"direct_fallbacks", report.solver_fallbacks}}},
        {"guard",
         {{"faces_bad_before_guard", report.flipped_before_guard},
          {"faces_low_quality_before_guard", report.low_quality_before_guard},
