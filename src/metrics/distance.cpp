@@ -14,6 +14,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_invoke.h>
+#include <tbb/parallel_sort.h>
 #include <tbb/partitioner.h>
 
 #include <algorithm>
@@ -22,6 +23,7 @@
 #include <mutex>
 #include <numeric>
 #include <random>
+#include <span>
 #include <stdexcept>
 #include <string>
 
@@ -131,8 +133,8 @@ class ClosestPointTraits {
 
 // Queries run in blocks of this many points. A block's first query starts from the guess of
 // the tree's k-d tree, each later one from the triangle of the previous answer (consecutive
-// points are close: samples are sorted by face, edges by vertex); fixed blocks make the answers
-// independent of how TBB schedules them.
+// points are close: samples are sorted along a Morton curve, edges by vertex); fixed blocks
+// make the answers independent of how TBB schedules them.
 constexpr std::size_t kQueryBlock = 256;
 
 Kernel::Point_3 to_cgal(const Eigen::Vector3d& p) {
@@ -184,14 +186,19 @@ void sort_along_morton_curve(Vertices& P, std::int64_t first, std::int64_t count
   // but fixed).
   const auto cell = [](double t) { return t >= 0 ? static_cast<std::uint64_t>(std::min(t, 2097151.0)) : 0; };
   std::vector<std::pair<std::uint64_t, std::int64_t>> key(static_cast<std::size_t>(count));
-  for (std::int64_t i = 0; i < count; ++i) {
-    const Eigen::RowVector3d t = (rows.row(i) - low).cwiseProduct(scale);
-    key[static_cast<std::size_t>(i)] = {
-        morton_spread_21(cell(t.x())) | morton_spread_21(cell(t.y())) << 1 | morton_spread_21(cell(t.z())) << 2, i};
-  }
-  std::sort(key.begin(), key.end());
+  tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, count, 4096), [&](const tbb::blocked_range<std::int64_t>& r) {
+    for (std::int64_t i = r.begin(); i != r.end(); ++i) {
+      const Eigen::RowVector3d t = (rows.row(i) - low).cwiseProduct(scale);
+      key[static_cast<std::size_t>(i)] = {
+          morton_spread_21(cell(t.x())) | morton_spread_21(cell(t.y())) << 1 | morton_spread_21(cell(t.z())) << 2, i};
+    }
+  });
+  // The keys are unique (each carries its row), so the order is the same for any thread count.
+  tbb::parallel_sort(key.begin(), key.end());
   const Vertices copy = rows;
-  for (std::int64_t i = 0; i < count; ++i) rows.row(i) = copy.row(key[static_cast<std::size_t>(i)].second);
+  tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, count, 4096), [&](const tbb::blocked_range<std::int64_t>& r) {
+    for (std::int64_t i = r.begin(); i != r.end(); ++i) rows.row(i) = copy.row(key[static_cast<std::size_t>(i)].second);
+  });
 }
 
 // Each undirected edge of F once, as (smaller vertex) << 32 | (larger vertex), in increasing
@@ -322,6 +329,7 @@ SurfaceSamples sample_surface(const Vertices& V, const Faces& F, const SamplingO
     const auto i = static_cast<Index>(e >> 32), j = static_cast<Index>(e & 0xffffffffu);
     s.points.row(first_midpoint + k) = 0.5 * (V.row(i) + V.row(j));
   }
+  sort_along_morton_curve(s.points, 0, s.num_area_samples);
   if (vertices_taken < all_vertices) sort_along_morton_curve(s.points, s.num_area_samples, vertices_taken);
   if (midpoints_taken < all_midpoints) sort_along_morton_curve(s.points, first_midpoint, midpoints_taken);
   return s;
@@ -363,8 +371,11 @@ struct DistanceQuery::Impl {
   // Runs fn(point index, query point, CGAL answer) for the rows [first, last) of P, in fixed
   // blocks (see kQueryBlock). With skip_at_most >= 0, a point whose first guess is already
   // within that squared distance is skipped (its distance cannot exceed it): for maxima.
+  // `near_faces`, when given, names a face of B near each point's answer (or -1): the search
+  // starts from that face instead of the previous point's.
   template <class Fn>
-  void for_each_closest(const Vertices& P, std::size_t first, std::size_t last, double skip_at_most, Fn&& fn) const {
+  void for_each_closest(const Vertices& P, std::size_t first, std::size_t last, double skip_at_most, Fn&& fn,
+                        const Index* near_faces = nullptr) const {
     const std::size_t blocks = (last - first + kQueryBlock - 1) / kQueryBlock;
     tbb::parallel_for(
         tbb::blocked_range<std::size_t>(0, blocks, 1),
@@ -374,7 +385,10 @@ struct DistanceQuery::Impl {
             Tree::Point_and_primitive_id hint;
             for (std::size_t i = begin; i < end; ++i) {
               const Kernel::Point_3 q = to_cgal(P.row(static_cast<Eigen::Index>(i)).transpose());
-              if (i == begin) {
+              if (near_faces && near_faces[i] >= 0) {
+                hint.second = near_faces[i];
+                hint.first = Kernel().construct_projected_point_3_object()(mesh.triangle(hint.second), q);
+              } else if (i == begin) {
                 hint = any_hint(q);
               } else {
                 // Start from the closest point of the previous answer's triangle: a tighter
@@ -510,10 +524,22 @@ ClosestPoint DistanceQuery::closest_point(const Eigen::Vector3d& p) const {
 }
 
 std::vector<ClosestPoint> DistanceQuery::closest_points(const Vertices& P) const {
+  return closest_points(P, {});
+}
+
+std::vector<ClosestPoint> DistanceQuery::closest_points(const Vertices& P, std::span<const Index> near_faces) const {
+  if (!near_faces.empty() && near_faces.size() != static_cast<std::size_t>(P.rows()))
+    throw std::invalid_argument("closest_points: near_faces must have one face per point");
+  const auto faces = static_cast<Index>(impl_->mesh.F->rows());
+  for (const Index f : near_faces)
+    if (f >= faces) throw std::invalid_argument("closest_points: a near face is out of range");
   std::vector<ClosestPoint> out(static_cast<std::size_t>(P.rows()));
-  impl_->for_each_closest(P, [&](std::size_t i, const Kernel::Point_3& q, const Tree::Point_and_primitive_id& a) {
-    out[i] = impl_->make_answer(q, a);
-  });
+  impl_->for_each_closest(
+      P, 0, static_cast<std::size_t>(P.rows()), -1.0,
+      [&](std::size_t i, const Kernel::Point_3& q, const Tree::Point_and_primitive_id& a) {
+        out[i] = impl_->make_answer(q, a);
+      },
+      near_faces.empty() ? nullptr : near_faces.data());
   return out;
 }
 

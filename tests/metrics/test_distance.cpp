@@ -138,6 +138,39 @@ TEST(DistanceQuery, MatchesBruteForceOnALargeMeshOfTwoTrees) {
   }
 }
 
+// A guessed face per point (the fit's previous round) changes where the search starts, never
+// the distance: exact guesses, wrong ones, none (-1) and no list all give brute force's answer.
+// A wrong-sized list or a face out of range throws.
+TEST(DistanceQuery, GuessedFacesChangeNoDistance) {
+  for (const Mesh& mesh : {test::torus(1.0, 0.3, 24, 12), test::torus(1.0, 0.3, 500, 201)}) {
+    const DistanceQuery query(mesh.V, mesh.F);
+    const Vertices P = query_points(mesh, 300, 5);
+    const std::vector<ClosestPoint> plain = query.closest_points(P);
+    std::vector<Index> exact(plain.size()), wrong(plain.size()), mixed(plain.size());
+    std::mt19937 random(9);
+    for (std::size_t i = 0; i < plain.size(); ++i) {
+      exact[i] = plain[i].face;
+      wrong[i] = static_cast<Index>(random() % static_cast<unsigned>(mesh.num_faces()));
+      mixed[i] = i % 3 == 0 ? -1 : i % 3 == 1 ? exact[i] : wrong[i];
+    }
+    const double scale = bounding_box(mesh.V).diagonal();
+    for (const auto* guesses : {&exact, &wrong, &mixed}) {
+      const std::vector<ClosestPoint> guessed = query.closest_points(P, *guesses);
+      ASSERT_EQ(guessed.size(), plain.size());
+      for (std::size_t i = 0; i < plain.size(); ++i) {
+        const Eigen::Vector3d p = P.row(static_cast<Index>(i)).transpose();
+        ASSERT_NEAR(std::sqrt(guessed[i].squared_distance), brute_force_distance(p, mesh), 1e-12 * scale) << i;
+        EXPECT_NEAR(point_triangle_distance(p, mesh, guessed[i].face), std::sqrt(guessed[i].squared_distance),
+                    1e-12 * scale);
+      }
+    }
+    EXPECT_THROW((void)query.closest_points(P, std::vector<Index>(3, 0)), std::invalid_argument);
+    std::vector<Index> out_of_range(plain.size(), 0);
+    out_of_range[7] = static_cast<Index>(mesh.num_faces());
+    EXPECT_THROW((void)query.closest_points(P, out_of_range), std::invalid_argument);
+  }
+}
+
 // A tree that borrows the caller's V and F answers as one over its own copy, for one tree and
 // for the two of a large mesh, and names the caller's arrays as its mesh.
 TEST(DistanceQuery, BorrowedMeshGivesTheSameAnswers) {
