@@ -292,34 +292,47 @@ SurfaceSamples sample_surface(const Vertices& V, const Faces& F, const SamplingO
     std::mt19937_64 random(options.seed);
     const auto uniform = [&random] { return static_cast<double>(random() >> 11) * 0x1.0p-53; };
     const auto n = static_cast<std::size_t>(s.num_area_samples);
-    std::vector<Index> face(n);
-    std::vector<double> r1(n), r2(n);
-    std::vector<Index> offset(static_cast<std::size_t>(nf) + 1, 0);
+    // The stream is drawn in one pass (three numbers a sample, in the order of the samples);
+    // the faces' binary searches, which miss the cache on a large mesh, run in parallel, and so
+    // does the placing of the points.
+    std::vector<double> u(n), r1(n), r2(n);
     for (std::size_t i = 0; i < n; ++i) {
-      const double u = uniform() * total;
-      const auto it = std::upper_bound(cumulative.begin(), cumulative.end(), u);
-      // u < total = cumulative.back() unless rounding made them equal: take the last face of
-      // non-zero area then.
-      auto f = static_cast<Index>(it - cumulative.begin());
-      if (f == nf)
-        f = static_cast<Index>(std::lower_bound(cumulative.begin(), cumulative.end(), total) - cumulative.begin());
-      face[i] = f;
+      u[i] = uniform() * total;
       r1[i] = uniform();
       r2[i] = uniform();
-      ++offset[static_cast<std::size_t>(f) + 1];
     }
-    // Counting sort by face (stable, so the order within a face is the order of drawing).
-    for (Index f = 0; f < nf; ++f) offset[static_cast<std::size_t>(f) + 1] += offset[static_cast<std::size_t>(f)];
-    for (std::size_t i = 0; i < n; ++i) {
-      const Index f = face[i];
-      double a = r1[i], b = r2[i];
-      if (a + b > 1) {  // reflect the far half of the unit square onto the triangle: uniform
-        a = 1 - a;
-        b = 1 - b;
+    std::vector<Index> face(n);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+        const auto it = std::upper_bound(cumulative.begin(), cumulative.end(), u[i]);
+        // u < total = cumulative.back() unless rounding made them equal: take the last face of
+        // non-zero area then.
+        auto f = static_cast<Index>(it - cumulative.begin());
+        if (f == nf)
+          f = static_cast<Index>(std::lower_bound(cumulative.begin(), cumulative.end(), total) - cumulative.begin());
+        face[i] = f;
       }
-      const Eigen::RowVector3d p0 = V.row(F(f, 0));
-      s.points.row(offset[static_cast<std::size_t>(f)]++) = p0 + a * (V.row(F(f, 1)) - p0) + b * (V.row(F(f, 2)) - p0);
-    }
+    });
+    std::vector<double>().swap(u);
+    // Counting sort by face (stable, so the order within a face is the order of drawing): each
+    // sample's row, then the points in parallel.
+    std::vector<Index> offset(static_cast<std::size_t>(nf) + 1, 0);
+    for (std::size_t i = 0; i < n; ++i) ++offset[static_cast<std::size_t>(face[i]) + 1];
+    for (Index f = 0; f < nf; ++f) offset[static_cast<std::size_t>(f) + 1] += offset[static_cast<std::size_t>(f)];
+    std::vector<Index> row(n);
+    for (std::size_t i = 0; i < n; ++i) row[i] = offset[static_cast<std::size_t>(face[i])]++;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i) {
+        const Index f = face[i];
+        double a = r1[i], b = r2[i];
+        if (a + b > 1) {  // reflect the far half of the unit square onto the triangle: uniform
+          a = 1 - a;
+          b = 1 - b;
+        }
+        const Eigen::RowVector3d p0 = V.row(F(f, 0));
+        s.points.row(row[i]) = p0 + a * (V.row(F(f, 1)) - p0) + b * (V.row(F(f, 2)) - p0);
+      }
+    });
   }
   for (std::int64_t k = 0; k < vertices_taken; ++k)
     s.points.row(s.num_area_samples + k) = V.row(take(vertices_taken, all_vertices, k));
