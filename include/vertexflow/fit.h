@@ -51,7 +51,8 @@ enum class FitSolver {
   /// Conjugate gradients on each round's step, block-Jacobi preconditioned, to a relative
   /// residual of kFitIterativeTolerance (about 20 iterations a round on every mesh measured);
   /// the direct solve takes over a round whose iteration has not converged within
-  /// kFitMaxIterations. Faster than Direct at every size measured (4.5k to 500k vertices).
+  /// FitOptions::max_solver_iterations. Faster than Direct at every size measured (4.5k to 500k
+  /// vertices).
   Iterative,
   /// CHOLMOD's sparse Cholesky factorisation. Its fill-reducing ordering and factorisation grow
   /// faster than the mesh: 5.2 s and 3.6 s for 346k vertices.
@@ -60,8 +61,6 @@ enum class FitSolver {
 
 /// The relative residual |b - A d| / |b| at which the iterative solve of a round's step stops.
 inline constexpr double kFitIterativeTolerance = 1e-10;
-/// Iterations of one round's iterative solve before the direct solve takes over.
-inline constexpr int kFitMaxIterations = 1000;
 
 struct FitOptions {
   /// Area-uniform samples of the reference per vertex of the mesh. Measured on a 6k remesh of
@@ -93,8 +92,10 @@ struct FitOptions {
   /// of the measurement's, so a fit was scored partly on its own data points (amo's lod gain
   /// over QEM: -11.5% measured that way, -10.5% with the fit on another stream).
   std::uint64_t seed = 1;
-  /// How each round's linear system is solved (FitSolver).
+  /// How each round's linear system is solved (FitSolver), and the iterations of one round's
+  /// iterative solve after which the direct solve takes over (no mesh measured came near it).
   FitSolver solver = FitSolver::Iterative;
+  int max_solver_iterations = 1000;
 };
 
 /// The seed of the stream the fit draws its samples of the reference from, for FitOptions::seed:

@@ -28,6 +28,7 @@ void validate_fit_options(const FitOptions& o, Index num_vertices, const char* w
   require(std::isfinite(o.fairness) && o.fairness >= 0, "fairness must be a finite number >= 0");
   require(std::isfinite(o.proximity) && o.proximity > 0, "proximity must be a finite number > 0");
   require(o.max_rounds >= 1, "max_rounds must be at least 1");
+  require(o.max_solver_iterations >= 1, "max_solver_iterations must be at least 1");
   require(std::isfinite(o.tolerance) && o.tolerance >= 0, "tolerance must be a finite number >= 0");
   validate_guard_options(o.guard, what);
   validate_vertex_constraints(o.constraints, num_vertices, what);

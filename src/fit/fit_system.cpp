@@ -281,10 +281,11 @@ class IterativeFitSystem final : public FitSystem, BlockOperator {
     });
     if (w_fair_ > 0) laplacian_.resize(b.size());
     ConjugateGradients cg(*this, std::move(inverse), b);
-    const IterationResult result = cg.run(kFitMaxIterations, kFitIterativeTolerance);
+    const IterationResult result = cg.run(options.max_solver_iterations, kFitIterativeTolerance);
     report.solver_iterations += result.iterations;
     if (!result.converged) {
-      // A safety net that no mesh measured needed (docs/benchmarks.md, "Fit solvers").
+      // A safety net that no mesh measured needed (docs/benchmarks.md, "Fit solvers"); tested
+      // by capping the iterations (FitSolvers.RoundsThatDoNotConvergeAreSolvedDirectly).
       ++report.solver_fallbacks;
       if (!direct_) direct_ = std::make_unique<DirectFitSystem>(F_, topology_, fixed_, options_.fairness);
       laplacian_.resize(0);

@@ -131,7 +131,8 @@ void to_json(nlohmann::json& j, const FitOptions& options) {
        {"min_quality", options.guard.min_quality},
        {"sliver_floor", options.guard.sliver_floor},
        {"seed", options.seed},
-       {"solver", options.solver}};
+       {"solver", options.solver},
+       {"max_solver_iterations", options.max_solver_iterations}};
 }
 
 void to_json(nlohmann::json& j, const FitReport& report) {

@@ -238,6 +238,27 @@ TEST(FitSolvers, IterativeAndDirectFitAlike) {
   EXPECT_GT(smooth_iterative.report.solver_iterations, 0);
 }
 
+// A round whose iteration does not converge within max_solver_iterations is solved directly:
+// capped at 2 iterations (measured: 18 a round needed), every round falls back, and the fit is
+// the direct one up to rounding.
+TEST(FitSolvers, RoundsThatDoNotConvergeAreSolvedDirectly) {
+  const Mesh coarse = test::icosphere(1.0, 2), dense = test::icosphere(1.0, 5);
+  FitOptions options;
+  options.solver = FitSolver::Direct;
+  const FitResult direct = fit_to_reference(coarse.V, coarse.F, dense.V, dense.F, options);
+  options.solver = FitSolver::Iterative;
+  options.max_solver_iterations = 2;
+  const FitResult capped = fit_to_reference(coarse.V, coarse.F, dense.V, dense.F, options);
+  ASSERT_GT(capped.report.rounds, 0);
+  EXPECT_EQ(capped.report.solver_fallbacks, capped.report.rounds);
+  EXPECT_EQ(capped.report.solver_iterations, 2 * capped.report.rounds);
+  EXPECT_EQ(capped.report.rounds, direct.report.rounds);
+  EXPECT_LT((capped.V - direct.V).cwiseAbs().maxCoeff(), 1e-12);  // the same solve
+  EXPECT_GT((direct.V - coarse.V).rowwise().norm().mean(), 1e-3);
+  options.max_solver_iterations = 0;
+  EXPECT_THROW(fit_to_reference(coarse.V, coarse.F, dense.V, dense.F, options), std::invalid_argument);
+}
+
 TEST(FitToReference, RefusesBadInputAndOptions) {
   const Mesh sphere = test::icosphere(1.0, 1);
   EXPECT_THROW(fit_to_reference(sphere.V, sphere.F, Vertices(0, 3), Faces(0, 3)), std::invalid_argument);
