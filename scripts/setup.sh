@@ -25,6 +25,7 @@ packages=(
   libgtest-dev libgmock-dev
   libbenchmark-dev
   libmeshoptimizer-dev     # meshoptimizer, the LoD peer of bench/lod_peers.cpp
+  libembree-dev            # Embree 3, the point-query peer measured by bench/point_query_peers.cpp (only there)
   clang libclang-rt-14-dev # libFuzzer targets and sanitizers
   clang-format
   python3                  # bench/make_results.py (docs/results.md)
