@@ -51,7 +51,7 @@ enum class FitSolver {
   /// Conjugate gradients on each round's step, block-Jacobi preconditioned, to a relative
   /// residual of kFitIterativeTolerance (about 20 iterations a round on every mesh measured);
   /// the direct solve takes over a round whose iteration has not converged within
-  /// FitOptions::max_solver_iterations. Faster than Direct at every size measured (4.5k to 500k
+  /// FitOptions::max_solver_iterations. Faster than Direct at every size measured (4.5k to 346k
   /// vertices).
   Iterative,
   /// CHOLMOD's sparse Cholesky factorisation. Its fill-reducing ordering and factorisation grow
