@@ -204,7 +204,7 @@ class IterativeFitSystem final : public FitSystem, BlockOperator {
  public:
   IterativeFitSystem(const Faces& F, const Topology& topology, const std::vector<char>& fixed,
                      const FitOptions& options)
-      : F_(F), topology_(topology), fixed_(fixed), options_(options), n_(static_cast<Index>(fixed.size())) {
+      : F_(F), topology_(topology), fixed_(fixed), n_(static_cast<Index>(fixed.size())) {
     row_start_.resize(static_cast<std::size_t>(n_) + 1);
     row_start_[0] = 0;
     for (Index i = 0; i < n_; ++i)
@@ -287,7 +287,7 @@ class IterativeFitSystem final : public FitSystem, BlockOperator {
       // A safety net that no mesh measured needed (docs/benchmarks.md, "Fit solvers"); tested
       // by capping the iterations (FitSolvers.RoundsThatDoNotConvergeAreSolvedDirectly).
       ++report.solver_fallbacks;
-      if (!direct_) direct_ = std::make_unique<DirectFitSystem>(F_, topology_, fixed_, options_.fairness);
+      if (!direct_) direct_ = std::make_unique<DirectFitSystem>(F_, topology_, fixed_, options.fairness);
       laplacian_.resize(0);
       return direct_->solve(X, to_mesh, to_reference, options, report);
     }
@@ -356,7 +356,6 @@ class IterativeFitSystem final : public FitSystem, BlockOperator {
   const Faces& F_;
   const Topology& topology_;
   const std::vector<char>& fixed_;
-  const FitOptions& options_;
   Index n_;
   std::vector<std::int64_t> row_start_;
   std::vector<Index> columns_;

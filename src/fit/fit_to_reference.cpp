@@ -85,15 +85,15 @@ double rows_to_reference(const Vertices& X, const Faces& F, const DistanceQuery&
     sorted.row(k) = point(s);
     if (!guesses.empty()) guesses[static_cast<std::size_t>(k)] = reference_faces[static_cast<std::size_t>(s)];
   });
-  std::vector<ClosestPoint> closest_sorted = reference.closest_points(sorted, guesses);
-  std::vector<ClosestPoint> closest(closest_sorted.size());
-  parallel_for_index(n + m, [&](Index k) {
-    closest[static_cast<std::size_t>(order[static_cast<std::size_t>(k)])] = closest_sorted[static_cast<std::size_t>(k)];
-  });
+  const std::vector<ClosestPoint> closest = reference.closest_points(sorted, guesses);
+  // Each point's place along the curve, so that the rows are made (and summed) in their own
+  // order without a second copy of the answers.
+  std::vector<Index> rank(order.size());
+  parallel_for_index(n + m, [&](Index k) { rank[static_cast<std::size_t>(order[static_cast<std::size_t>(k)])] = k; });
   to_reference.resize(closest.size());
   reference_faces.resize(closest.size());
   const double sum_to_reference = sum_over_vertices(n + m, 0.0, [&](Index s) {
-    const ClosestPoint& c = closest[static_cast<std::size_t>(s)];
+    const ClosestPoint& c = closest[static_cast<std::size_t>(rank[static_cast<std::size_t>(s)])];
     to_reference[static_cast<std::size_t>(s)] =
         s < n ? DataRow{-1, {static_cast<int>(s), static_cast<int>(s), static_cast<int>(s)}, {1.0, 0.0, 0.0}, c.point}
               : DataRow{s - n, F.row(s - n).transpose(), Eigen::Vector3d::Constant(1.0 / 3.0), c.point};
