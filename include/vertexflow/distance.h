@@ -31,6 +31,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <span>
 #include <vector>
@@ -126,6 +127,15 @@ class DistanceQuery {
   /// std::invalid_argument unless near_faces is empty (no guesses) or has one entry per row of P,
   /// each below B's face count.
   [[nodiscard]] std::vector<ClosestPoint> closest_points(const Vertices& P, std::span<const Index> near_faces) const;
+
+  /// The same answers as closest_points(P, near_faces), handed to `visit(i, answer)` for each row
+  /// i of P instead of returned: once per row, from several threads at once (TBB) and in no fixed
+  /// order, so `visit` must be safe to call concurrently for different rows (writing row i's own
+  /// slot of an array is). What a caller that turns the answers into something else at once
+  /// needs: no array of #P answers (64 bytes each) is made, filled and read back. Throws as
+  /// closest_points does.
+  void for_each_closest_point(const Vertices& P, std::span<const Index> near_faces,
+                              const std::function<void(Index, const ClosestPoint&)>& visit) const;
 
   /// Squared distance from every row of P to B (#P), in parallel, thread-count independent.
   [[nodiscard]] Eigen::VectorXd squared_distances(const Vertices& P) const;

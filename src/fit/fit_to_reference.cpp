@@ -18,6 +18,7 @@
 #include <chrono>
 #include <cmath>
 #include <optional>
+#include <span>
 #include <stdexcept>
 #include <string>
 
@@ -34,27 +35,43 @@ std::uint64_t fit_sample_seed(std::uint64_t seed) {
 
 namespace {
 
+// What the rounds' queries reuse from one round to the next: every round has the same sizes, so
+// these are allocated, and their pages first touched, once per fit. (Made anew each round, the
+// answers alone were 64 bytes a point; page faults were about a tenth of the fit's time on lod's
+// first level of a 1M-vertex mesh, 5M samples.)
+struct QueryBuffers {
+  std::vector<Index> near;      // rows_to_mesh's guesses, one per sample
+  std::vector<double> squared;  // each point's squared distance, summed in the points' order
+  Vertices sorted;              // rows_to_reference's points along the curve
+  std::vector<Index> guesses;   // and their guesses
+};
+
 // The data rows of one round, first direction: the reference's samples at their foot points on
 // the mesh X. Returns their mean squared distance. The searches start from the faces of the
 // previous round's rows, when there are any: the vertices have moved little since, so most feet
 // stay on their face, and that first guess prunes more of the tree (lod's first level of a
 // 692k-vertex mesh: 3.5M samples in 2.2 s a round instead of 2.8 s).
-double rows_to_mesh(const Vertices& X, const Faces& F, const Vertices& samples, std::vector<DataRow>& to_mesh) {
+double rows_to_mesh(const Vertices& X, const Faces& F, const Vertices& samples, std::vector<DataRow>& to_mesh,
+                    QueryBuffers& buffers) {
   const DistanceQuery mesh(X, F, DistanceQuery::Borrow{});
-  std::vector<Index> near;
-  if (to_mesh.size() == static_cast<std::size_t>(samples.rows())) {
-    near.resize(to_mesh.size());
-    for (std::size_t j = 0; j < near.size(); ++j) near[j] = to_mesh[j].face;
+  const Index count = samples.rows();
+  const bool guessed = to_mesh.size() == static_cast<std::size_t>(count);
+  if (guessed) {
+    buffers.near.resize(to_mesh.size());
+    parallel_for_index(
+        count, [&](Index j) { buffers.near[static_cast<std::size_t>(j)] = to_mesh[static_cast<std::size_t>(j)].face; });
   }
-  const std::vector<ClosestPoint> feet = mesh.closest_points(samples, near);
-  to_mesh.resize(feet.size());
-  const double sum_to_mesh = sum_over_vertices(static_cast<Index>(feet.size()), 0.0, [&](Index j) {
-    const ClosestPoint& foot = feet[static_cast<std::size_t>(j)];
-    to_mesh[static_cast<std::size_t>(j)] = {foot.face, F.row(foot.face).transpose(), foot.barycentric,
-                                            samples.row(j).transpose()};
-    return foot.squared_distance;
-  });
-  return sum_to_mesh / static_cast<double>(feet.size());
+  to_mesh.resize(static_cast<std::size_t>(count));
+  buffers.squared.resize(static_cast<std::size_t>(count));
+  mesh.for_each_closest_point(samples, guessed ? std::span<const Index>(buffers.near) : std::span<const Index>(),
+                              [&](Index j, const ClosestPoint& foot) {
+                                to_mesh[static_cast<std::size_t>(j)] = {foot.face, F.row(foot.face).transpose(),
+                                                                        foot.barycentric, samples.row(j).transpose()};
+                                buffers.squared[static_cast<std::size_t>(j)] = foot.squared_distance;
+                              });
+  const double sum_to_mesh =
+      sum_over_vertices(count, 0.0, [&](Index j) { return buffers.squared[static_cast<std::size_t>(j)]; });
+  return sum_to_mesh / static_cast<double>(count);
 }
 
 // Second direction: the mesh's vertices and face centroids at their closest points on the
@@ -67,7 +84,7 @@ double rows_to_mesh(const Vertices& X, const Faces& F, const Vertices& samples, 
 // face.
 double rows_to_reference(const Vertices& X, const Faces& F, const DistanceQuery& reference,
                          std::vector<DataRow>& to_reference, std::vector<Index>& reference_faces,
-                         std::vector<Index>& order) {
+                         std::vector<Index>& order, QueryBuffers& buffers) {
   const Index n = X.rows(), m = F.rows();
   auto point = [&](Index s) -> Eigen::RowVector3d {
     return s < n ? Eigen::RowVector3d(X.row(s))
@@ -78,28 +95,29 @@ double rows_to_reference(const Vertices& X, const Faces& F, const DistanceQuery&
     parallel_for_index(n + m, [&](Index s) { points.row(s) = point(s); });
     order = space_filling_order(points);
   }
-  Vertices sorted(n + m, 3);
-  std::vector<Index> guesses(reference_faces.empty() ? 0 : order.size());
+  const bool guessed = !reference_faces.empty();
+  buffers.sorted.resize(n + m, 3);
+  buffers.guesses.resize(guessed ? order.size() : 0);
   parallel_for_index(n + m, [&](Index k) {
     const Index s = order[static_cast<std::size_t>(k)];
-    sorted.row(k) = point(s);
-    if (!guesses.empty()) guesses[static_cast<std::size_t>(k)] = reference_faces[static_cast<std::size_t>(s)];
+    buffers.sorted.row(k) = point(s);
+    if (guessed) buffers.guesses[static_cast<std::size_t>(k)] = reference_faces[static_cast<std::size_t>(s)];
   });
-  const std::vector<ClosestPoint> closest = reference.closest_points(sorted, guesses);
-  // Each point's place along the curve, so that the rows are made (and summed) in their own
-  // order without a second copy of the answers.
-  std::vector<Index> rank(order.size());
-  parallel_for_index(n + m, [&](Index k) { rank[static_cast<std::size_t>(order[static_cast<std::size_t>(k)])] = k; });
-  to_reference.resize(closest.size());
-  reference_faces.resize(closest.size());
-  const double sum_to_reference = sum_over_vertices(n + m, 0.0, [&](Index s) {
-    const ClosestPoint& c = closest[static_cast<std::size_t>(rank[static_cast<std::size_t>(s)])];
+  to_reference.resize(order.size());
+  reference_faces.resize(order.size());
+  buffers.squared.resize(order.size());
+  // Each answer goes straight to its point's row (the guesses were copied above, so a point's
+  // guess is never overwritten before it is read); the rows are summed in their own order.
+  reference.for_each_closest_point(buffers.sorted, buffers.guesses, [&](Index k, const ClosestPoint& c) {
+    const Index s = order[static_cast<std::size_t>(k)];
     to_reference[static_cast<std::size_t>(s)] =
         s < n ? DataRow{-1, {static_cast<int>(s), static_cast<int>(s), static_cast<int>(s)}, {1.0, 0.0, 0.0}, c.point}
               : DataRow{s - n, F.row(s - n).transpose(), Eigen::Vector3d::Constant(1.0 / 3.0), c.point};
     reference_faces[static_cast<std::size_t>(s)] = c.face;
-    return c.squared_distance;
+    buffers.squared[static_cast<std::size_t>(s)] = c.squared_distance;
   });
+  const double sum_to_reference =
+      sum_over_vertices(n + m, 0.0, [&](Index s) { return buffers.squared[static_cast<std::size_t>(s)]; });
   return sum_to_reference / static_cast<double>(n + m);
 }
 
@@ -132,6 +150,7 @@ FitResult fit_to_reference(const Vertices& V, const Faces& F, const ReferenceSur
   std::vector<DataRow> to_mesh, to_reference;
   std::vector<Index> reference_faces;  // the closest face of the reference to each mesh point
   std::vector<Index> point_order;      // the mesh points' Morton order (rows_to_reference)
+  QueryBuffers buffers;
   tbb::parallel_invoke([&] { (void)reference.distance_query(); },
                        [&] {
                          SamplingOptions sampling;
@@ -154,8 +173,8 @@ FitResult fit_to_reference(const Vertices& V, const Faces& F, const ReferenceSur
     report_progress(fmt::format("fit round {}", round + 1), kTreeEnds + round * round_width,
                     kTreeEnds + (round + 1) * round_width);
     start = Clock::now();
-    const double to_mesh_ms = rows_to_mesh(X, F, samples, to_mesh);
-    const double to_reference_ms = rows_to_reference(X, F, tree, to_reference, reference_faces, point_order);
+    const double to_mesh_ms = rows_to_mesh(X, F, samples, to_mesh, buffers);
+    const double to_reference_ms = rows_to_reference(X, F, tree, to_reference, reference_faces, point_order, buffers);
     report.seconds_queries += seconds_since(start);
     const double energy = 0.5 * (to_mesh_ms + to_reference_ms);
     report.rms_distance.push_back(std::sqrt(energy));

@@ -540,12 +540,19 @@ std::vector<ClosestPoint> DistanceQuery::closest_points(const Vertices& P) const
   return closest_points(P, {});
 }
 
-std::vector<ClosestPoint> DistanceQuery::closest_points(const Vertices& P, std::span<const Index> near_faces) const {
+namespace {
+
+void check_near_faces(const Vertices& P, std::span<const Index> near_faces, Index faces) {
   if (!near_faces.empty() && near_faces.size() != static_cast<std::size_t>(P.rows()))
     throw std::invalid_argument("closest_points: near_faces must have one face per point");
-  const auto faces = static_cast<Index>(impl_->mesh.F->rows());
   for (const Index f : near_faces)
     if (f >= faces) throw std::invalid_argument("closest_points: a near face is out of range");
+}
+
+}  // namespace
+
+std::vector<ClosestPoint> DistanceQuery::closest_points(const Vertices& P, std::span<const Index> near_faces) const {
+  check_near_faces(P, near_faces, static_cast<Index>(impl_->mesh.F->rows()));
   std::vector<ClosestPoint> out(static_cast<std::size_t>(P.rows()));
   impl_->for_each_closest(
       P, 0, static_cast<std::size_t>(P.rows()), -1.0,
@@ -554,6 +561,17 @@ std::vector<ClosestPoint> DistanceQuery::closest_points(const Vertices& P, std::
       },
       near_faces.empty() ? nullptr : near_faces.data());
   return out;
+}
+
+void DistanceQuery::for_each_closest_point(const Vertices& P, std::span<const Index> near_faces,
+                                           const std::function<void(Index, const ClosestPoint&)>& visit) const {
+  check_near_faces(P, near_faces, static_cast<Index>(impl_->mesh.F->rows()));
+  impl_->for_each_closest(
+      P, 0, static_cast<std::size_t>(P.rows()), -1.0,
+      [&](std::size_t i, const Kernel::Point_3& q, const Tree::Point_and_primitive_id& a) {
+        visit(static_cast<Index>(i), impl_->make_answer(q, a));
+      },
+      near_faces.empty() ? nullptr : near_faces.data());
 }
 
 Eigen::VectorXd DistanceQuery::squared_distances(const Vertices& P) const {

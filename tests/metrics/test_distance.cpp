@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cmath>
 #include <random>
 #include <set>
@@ -168,6 +169,38 @@ TEST(DistanceQuery, GuessedFacesChangeNoDistance) {
     std::vector<Index> out_of_range(plain.size(), 0);
     out_of_range[7] = static_cast<Index>(mesh.num_faces());
     EXPECT_THROW((void)query.closest_points(P, out_of_range), std::invalid_argument);
+  }
+}
+
+// for_each_closest_point hands over closest_points' answers, each row once, with and without
+// guesses, on one tree and on the two of a large mesh; and refuses what closest_points refuses.
+TEST(DistanceQuery, VisitedAnswersAreTheReturnedOnes) {
+  for (const Mesh& mesh : {test::torus(1.0, 0.3, 24, 12), test::torus(1.0, 0.3, 500, 201)}) {
+    const DistanceQuery query(mesh.V, mesh.F);
+    const Vertices P = query_points(mesh, 3000, 13);
+    std::vector<Index> guesses(static_cast<std::size_t>(P.rows()));
+    for (std::size_t i = 0; i < guesses.size(); ++i)
+      guesses[i] = static_cast<Index>((i * 7919) % static_cast<std::size_t>(mesh.num_faces()));
+    for (const std::span<const Index> near : {std::span<const Index>(), std::span<const Index>(guesses)}) {
+      const std::vector<ClosestPoint> returned = query.closest_points(P, near);
+      std::vector<ClosestPoint> visited(returned.size());
+      std::vector<std::atomic<int>> visits(returned.size());
+      query.for_each_closest_point(P, near, [&](Index i, const ClosestPoint& c) {
+        visited[static_cast<std::size_t>(i)] = c;
+        ++visits[static_cast<std::size_t>(i)];
+      });
+      for (std::size_t i = 0; i < returned.size(); ++i) {
+        ASSERT_EQ(visits[i].load(), 1) << i;
+        ASSERT_EQ(visited[i].face, returned[i].face) << i;
+        ASSERT_EQ(visited[i].point, returned[i].point) << i;
+        ASSERT_EQ(visited[i].barycentric, returned[i].barycentric) << i;
+        ASSERT_EQ(visited[i].squared_distance, returned[i].squared_distance) << i;
+      }
+    }
+    const auto ignore = [](Index, const ClosestPoint&) {};
+    EXPECT_THROW(query.for_each_closest_point(P, std::vector<Index>(3, 0), ignore), std::invalid_argument);
+    guesses[5] = static_cast<Index>(mesh.num_faces());
+    EXPECT_THROW(query.for_each_closest_point(P, guesses, ignore), std::invalid_argument);
   }
 }
 
