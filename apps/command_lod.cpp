@@ -15,6 +15,7 @@
 #include <limits>
 #include <optional>
 #include <sstream>
+#include <utility>
 
 namespace vertexflow::cli {
 namespace {
@@ -277,6 +278,7 @@ void register_lod_command(CLI::App& app, const GlobalOptions& global) {
       }
     }
     std::optional<ReferenceSurface> dense;
+    std::optional<SimplifyResult> simplified;  // the next level's QEM, made alongside a measurement (lod.h)
     for (std::size_t i = first_new; i < budgets.size(); ++i) {
       const std::string file = level_paths[i].filename().string();
       const double n = static_cast<double>(budgets.size());
@@ -289,8 +291,9 @@ void register_lod_command(CLI::App& app, const GlobalOptions& global) {
       say(fmt::format("level {}: simplifying to {} faces and fitting to {}", i + 1, budgets[i], o->input));
       LodLevel level;
       try {
-        level =
-            lod_level(i == 0 ? dense_mesh : previous, *dense, budgets[i], static_cast<int>(i + 1), options, callbacks);
+        const Index next = i + 1 < budgets.size() ? budgets[i + 1] : 0;
+        level = lod_level(i == 0 ? dense_mesh : previous, *dense, budgets[i], static_cast<int>(i + 1), options,
+                          callbacks, next, std::exchange(simplified, std::nullopt));
       } catch (const std::invalid_argument& e) {
         throw std::runtime_error(o->input + ": " + e.what());
       }
@@ -315,6 +318,7 @@ void register_lod_command(CLI::App& app, const GlobalOptions& global) {
       entry["file"] = file;
       summary["levels"].push_back(std::move(entry));
       previous = std::move(level.mesh);
+      simplified = std::move(level.next_simplified);
       if (o->html) kept_levels.push_back(previous);
       // The summary after every level, so that an interrupted run resumes from it.
       summary["seconds"] = seconds_since(start);

@@ -40,6 +40,7 @@
 #include <nlohmann/json.hpp>
 
 #include <functional>
+#include <optional>
 #include <vector>
 
 namespace vertexflow {
@@ -116,6 +117,10 @@ struct LodLevel {
   /// line in its comments, or QEM alone (kept_qem) without comments.
   Mesh mesh;
   LodLevelReport report;
+  /// `mesh` simplified to the next level's budget (lod_level's `next_target_faces`), for the next
+  /// lod_level to take as its `simplified`; empty when none was asked for, or when the level was
+  /// not fitted (the next lod_level then simplifies as usual).
+  std::optional<SimplifyResult> next_simplified;
 };
 
 /// The two-sided distances of `mesh` to D as every level's are measured (above), with
@@ -130,11 +135,23 @@ std::vector<Index> lod_face_budgets(Index dense_faces, const LodOptions& options
 
 /// One level: simplifies `previous` (D itself for level 1, the kept previous level otherwise) to
 /// `target_faces`, fits it to `dense` (and flips, with edge_flips), measures both against
-/// `dense` and keeps the better (above). `level` is only recorded. Throws std::invalid_argument
-/// as simplify() and enhance() do (a `previous` without faces, a `dense` that is not its surface
-/// in its units: check_reference_fits), or for `target_faces` below 1.
+/// `dense` and keeps the better (above). `level` is only recorded.
+///
+/// The chain's steps overlap where they can, and the results are the same bytes as one step
+/// after another. QEM runs on one thread, so the second core does other work meanwhile:
+/// - without `simplified`, D's tree and samples (ReferenceSurface) are built alongside QEM;
+/// - with `next_target_faces` > 0, the fitted level is simplified to that budget alongside its
+///   measurement, and returned as LodLevel::next_simplified. Where the measurement then keeps
+///   QEM alone (keep_better_of_two), that simplification is made again from QEM alone.
+/// `simplified`, when given, is `previous` simplified to `target_faces` with `options` (the
+/// previous level's next_simplified) and takes the place of this level's QEM.
+///
+/// Throws std::invalid_argument as simplify() and enhance() do (a `previous` without faces, a
+/// `dense` that is not its surface in its units: check_reference_fits), for `target_faces` below
+/// 1, or for a `simplified` whose report names another input or budget.
 LodLevel lod_level(const Mesh& previous, const ReferenceSurface& dense, Index target_faces, int level,
-                   const LodOptions& options = {}, const EnhanceCallbacks& callbacks = {});
+                   const LodOptions& options = {}, const EnhanceCallbacks& callbacks = {}, Index next_target_faces = 0,
+                   std::optional<SimplifyResult> simplified = std::nullopt);
 
 /// The whole chain on D = (`dense`, whose ReferenceSurface it builds once). `on_level` (may be
 /// empty) is called as each level is finished, in order. Reports progress (progress.h): level i

@@ -8,9 +8,11 @@
 #include "vertexflow/timing.h"
 
 #include <fmt/format.h>
+#include <tbb/parallel_invoke.h>
 
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 namespace vertexflow {
 namespace {
@@ -32,6 +34,14 @@ namespace {
 
 nlohmann::json to_json(const LodDistance& d) {
   return {{"mean", d.mean}, {"rms", d.rms}, {"hausdorff", d.hausdorff}};
+}
+
+SimplifyOptions simplify_options(Index target_faces, const LodOptions& options) {
+  SimplifyOptions o;
+  o.target_faces = target_faces;
+  o.keep_boundary = options.keep_boundary;
+  o.method = options.simplify_method;
+  return o;
 }
 
 // Reference mode's fit (and flips) with everything else at enhance's defaults: the same run as
@@ -79,8 +89,14 @@ std::vector<Index> lod_face_budgets(Index dense_faces, const LodOptions& options
 }
 
 LodLevel lod_level(const Mesh& previous, const ReferenceSurface& dense, Index target_faces, int level,
-                   const LodOptions& options, const EnhanceCallbacks& callbacks) {
+                   const LodOptions& options, const EnhanceCallbacks& callbacks, Index next_target_faces,
+                   std::optional<SimplifyResult> simplified) {
   if (target_faces < 1) throw std::invalid_argument("lod: a level's face budget must be at least 1");
+  if (simplified &&
+      (simplified->report.input_faces != previous.num_faces() || simplified->report.target_faces != target_faces))
+    throw std::invalid_argument(fmt::format(
+        "lod: the simplification given for level {} is of {} faces to {}, not of the previous level's {} to {}", level,
+        simplified->report.input_faces, simplified->report.target_faces, previous.num_faces(), target_faces));
   const auto start = Clock::now();
   LodLevel out;
   LodLevelReport& r = out.report;
@@ -91,12 +107,20 @@ LodLevel lod_level(const Mesh& previous, const ReferenceSurface& dense, Index ta
   // Progress (progress.h): costs guessed from the bunny's levels (simplify 1.3 s, fit 0.9 s,
   // measurements 0.4 s at 50%), flips doubling the fit.
   const double fit_end = options.edge_flips ? 0.8 : 0.65;
-  SimplifyOptions so;
-  so.target_faces = target_faces;
-  so.keep_boundary = options.keep_boundary;
-  so.method = options.simplify_method;
   report_progress("simplify", 0, 0.35);
-  SimplifyResult qem = simplify(previous.V, previous.F, so);
+  SimplifyResult qem;
+  if (simplified) {
+    qem = std::move(*simplified);
+  } else {
+    // QEM is serial (quadric_collapse.cpp); D's tree and samples, built on first use, take the
+    // other core meanwhile (on a 1M-vertex D, QEM is 8 s, the tree and samples about 1.5 s).
+    tbb::parallel_invoke([&] { qem = simplify(previous.V, previous.F, simplify_options(target_faces, options)); },
+                         [&] {
+                           const ProgressScope silent{ProgressSink{}};
+                           (void)dense.distance_query();
+                           (void)dense.samples(options.sampling);
+                         });
+  }
   r.simplify = qem.report;
   r.simplify_seconds = qem.report.seconds;
 
@@ -123,10 +147,27 @@ LodLevel lod_level(const Mesh& previous, const ReferenceSurface& dense, Index ta
 
     t = Clock::now();
     report_progress("measure", fit_end, 1);
-    r.fitted = lod_distance(fitted.mesh, dense, options.sampling);
-    r.measure_seconds += seconds_since(t);
+    // The next level's QEM alongside the measurement, from the fitted level: the level kept
+    // unless the measurement says otherwise (then it is made again below). The measurement's
+    // seconds are its own, though they overlap QEM's.
+    double measure_seconds = 0;
+    tbb::parallel_invoke(
+        [&] {
+          r.fitted = lod_distance(fitted.mesh, dense, options.sampling);
+          measure_seconds = seconds_since(t);
+        },
+        [&] {
+          if (next_target_faces <= 0) return;
+          const ProgressScope silent{ProgressSink{}};
+          out.next_simplified = simplify(fitted.mesh.V, fitted.mesh.F, simplify_options(next_target_faces, options));
+        });
+    r.measure_seconds += measure_seconds;
 
     r.kept_qem = options.keep_better_of_two && r.fitted.mean > r.qem.mean;
+    if (r.kept_qem && out.next_simplified) {
+      const ProgressScope silent{ProgressSink{}};
+      out.next_simplified = simplify(qem.mesh.V, qem.mesh.F, simplify_options(next_target_faces, options));
+    }
     out.mesh = r.kept_qem ? std::move(qem.mesh) : std::move(fitted.mesh);
   }
   r.faces = out.mesh.num_faces();
@@ -149,8 +190,11 @@ std::vector<LodLevel> lod(const ReferenceSurface& dense, const LodOptions& optio
       dense_mesh.V = dense.vertices();
       dense_mesh.F = dense.faces();
     }
+    const Index next = i + 1 < budgets.size() ? budgets[i + 1] : 0;
+    std::optional<SimplifyResult> simplified;
+    if (i > 0) simplified = std::exchange(levels.back().next_simplified, std::nullopt);
     levels.push_back(lod_level(i == 0 ? dense_mesh : levels.back().mesh, dense, budgets[i], static_cast<int>(i + 1),
-                               options, callbacks));
+                               options, callbacks, next, std::move(simplified)));
     if (on_level) on_level(levels.back());
   }
   return levels;

@@ -172,6 +172,58 @@ TEST(Lod, ExactLevelsAreNotFitted) {
   EXPECT_TRUE(level.mesh.comments.empty());  // no fit, no provenance line
 }
 
+// The chain's overlapped steps (lod.h): a level asked for the next budget returns the fitted
+// level simplified to it, the same bytes as simplify() makes from the level afterwards, and the
+// chain lod() makes through them is the chain made one step after another. A simplification
+// of another input or budget is refused; a level that is not fitted has none to hand on.
+TEST(Lod, OverlappedStepsGiveTheSameLevels) {
+  const Mesh dense = read_mesh(test::data_path("spot.obj"));
+  const ReferenceSurface reference(dense.V, dense.F);
+  const LodOptions options = quick({30, 10, 4});
+  const std::vector<Index> budgets = lod_face_budgets(dense.num_faces(), options);
+  const std::vector<LodLevel> chain = lod(reference, options);
+  ASSERT_EQ(chain.size(), budgets.size());
+  Mesh previous = dense;
+  for (std::size_t i = 0; i < budgets.size(); ++i) {
+    SCOPED_TRACE(i);
+    const Index next = i + 1 < budgets.size() ? budgets[i + 1] : 0;
+    LodLevel step = lod_level(previous, reference, budgets[i], static_cast<int>(i + 1), options, {}, next);
+    EXPECT_EQ(step.mesh.V, chain[i].mesh.V);
+    EXPECT_EQ(step.mesh.F, chain[i].mesh.F);
+    EXPECT_EQ(step.report.fitted.mean, chain[i].report.fitted.mean);
+    EXPECT_EQ(step.report.qem.hausdorff, chain[i].report.qem.hausdorff);
+    EXPECT_FALSE(chain[i].next_simplified.has_value());  // handed on to the next level
+    if (next > 0) {
+      ASSERT_FALSE(step.report.kept_qem);  // spot's levels are all fitted (measured)
+      ASSERT_TRUE(step.next_simplified.has_value());
+      SimplifyOptions so;
+      so.target_faces = next;
+      so.method = options.simplify_method;
+      const SimplifyResult afterwards = simplify(step.mesh.V, step.mesh.F, so);
+      EXPECT_EQ(step.next_simplified->mesh.V, afterwards.mesh.V);
+      EXPECT_EQ(step.next_simplified->mesh.F, afterwards.mesh.F);
+      EXPECT_EQ(step.next_simplified->report.target_faces, next);
+      EXPECT_EQ(step.next_simplified->report.input_faces, step.mesh.num_faces());
+    } else {
+      EXPECT_FALSE(step.next_simplified.has_value());
+    }
+    previous = std::move(step.mesh);
+  }
+  // The first level's simplification handed to a level of another budget, or of another input.
+  LodLevel first = lod_level(dense, reference, budgets[0], 1, options, {}, budgets[1]);
+  ASSERT_TRUE(first.next_simplified.has_value());
+  EXPECT_THROW((void)lod_level(first.mesh, reference, budgets[2], 2, options, {}, 0, first.next_simplified),
+               std::invalid_argument);
+  EXPECT_THROW((void)lod_level(dense, reference, budgets[1], 2, options, {}, 0, first.next_simplified),
+               std::invalid_argument);
+  // A level that QEM puts on the plate exactly is not fitted, and hands nothing on.
+  const Mesh plate = test::perforated_plate(1, 6, 0.2, true);
+  const ReferenceSurface plate_surface(plate.V, plate.F);
+  const LodLevel exact = lod_level(plate, plate_surface, 404, 1, options, {}, 200);
+  EXPECT_TRUE(exact.report.fit_skipped);
+  EXPECT_FALSE(exact.next_simplified.has_value());
+}
+
 // Identical bytes for 1 and 2 threads (docs/architecture.md's rule), levels and figures.
 TEST(Lod, SameBytesForAnyThreadCount) {
   const Mesh dense = read_mesh(test::data_path("spot.obj"));
