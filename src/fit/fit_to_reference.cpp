@@ -151,6 +151,8 @@ FitResult fit_to_reference(const Vertices& V, const Faces& F, const ReferenceSur
   std::vector<Index> reference_faces;  // the closest face of the reference to each mesh point
   std::vector<Index> point_order;      // the mesh points' Morton order (rows_to_reference)
   QueryBuffers buffers;
+  // Three branches: where the tree is already built (lod's levels), the samples and the set-up
+  // still overlap (lod's first level of a 1M-vertex mesh: 5M samples and a 500k-vertex set-up).
   tbb::parallel_invoke([&] { (void)reference.distance_query(); },
                        [&] {
                          SamplingOptions sampling;
@@ -160,8 +162,8 @@ FitResult fit_to_reference(const Vertices& V, const Faces& F, const ReferenceSur
                          sampling.vertices = false;
                          sampling.edge_midpoints = false;
                          samples_pointer = &reference.samples(sampling).points;
-                         rounds.emplace(V, F, options);
-                       });
+                       },
+                       [&] { rounds.emplace(V, F, options); });
   const Vertices& samples = *samples_pointer;
   const DistanceQuery& tree = reference.distance_query();
   report.reference_samples = samples.rows();
