@@ -229,6 +229,7 @@ void register_lod_command(CLI::App& app, const GlobalOptions& global) {
     report_progress("reading " + o->input, 0, 0.03);
     Mesh dense_mesh = read_mesh_with_warnings(o->input, global);
     warn_attributes_dropped(o->input, dense_mesh, "lod", global);
+    dense_mesh = in_morton_order(dense_mesh);  // the chain's order, as lod() runs it (lod.h)
     const Index dense_faces = dense_mesh.num_faces(), dense_vertices = dense_mesh.num_vertices();
     std::vector<Index> budgets;
     try {

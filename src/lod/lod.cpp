@@ -1,6 +1,8 @@
 // Levels of detail fitted to their dense mesh (lod.h): QEM, then reference mode's fit, per level.
 #include "vertexflow/lod.h"
 
+#include "numerics/parallel.h"
+#include "numerics/vertex_ordering.h"
 #include "vertexflow/edge_flips.h"
 #include "vertexflow/progress.h"
 #include "vertexflow/quality.h"
@@ -200,9 +202,34 @@ std::vector<LodLevel> lod(const ReferenceSurface& dense, const LodOptions& optio
   return levels;
 }
 
+Mesh in_morton_order(const Mesh& mesh) {
+  const Index nv = mesh.num_vertices(), nf = mesh.num_faces();
+  if (nf > 0 && (mesh.F.minCoeff() < 0 || mesh.F.maxCoeff() >= nv))
+    throw std::invalid_argument(fmt::format("lod: a face index is outside the {} vertices", nv));
+  const std::vector<Index> vertex_order = space_filling_order(mesh.V);  // new index -> old
+  std::vector<Index> new_index(static_cast<std::size_t>(nv));
+  for (Index k = 0; k < nv; ++k) new_index[static_cast<std::size_t>(vertex_order[static_cast<std::size_t>(k)])] = k;
+  Vertices centroids(nf, 3);
+  parallel_for_index(nf, [&](Index f) {
+    centroids.row(f) = (mesh.V.row(mesh.F(f, 0)) + mesh.V.row(mesh.F(f, 1)) + mesh.V.row(mesh.F(f, 2))) / 3.0;
+  });
+  const std::vector<Index> face_order = space_filling_order(centroids);
+  Mesh out;
+  out.V.resize(nv, 3);
+  parallel_for_index(nv, [&](Index k) { out.V.row(k) = mesh.V.row(vertex_order[static_cast<std::size_t>(k)]); });
+  out.F.resize(nf, 3);
+  parallel_for_index(nf, [&](Index k) {
+    for (int c = 0; c < 3; ++c)
+      out.F(k, c) = new_index[static_cast<std::size_t>(mesh.F(face_order[static_cast<std::size_t>(k)], c))];
+  });
+  out.comments = mesh.comments;
+  return out;
+}
+
 std::vector<LodLevel> lod(const Mesh& dense, const LodOptions& options, const EnhanceCallbacks& callbacks,
                           const std::function<void(const LodLevel&)>& on_level) {
-  const ReferenceSurface reference(dense.V, dense.F);
+  Mesh ordered = in_morton_order(dense);
+  const ReferenceSurface reference(std::move(ordered.V), std::move(ordered.F));
   return lod(reference, options, callbacks, on_level);
 }
 

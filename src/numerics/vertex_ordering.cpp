@@ -5,6 +5,7 @@
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <utility>
 
@@ -20,7 +21,10 @@ std::vector<Index> space_filling_order(const Vertices& P) {
     std::uint64_t code = 0;
     for (int c = 0; c < 3; ++c) {
       const double unit = (P(i, c) - low[c]) / extent;
-      code |= morton_spread_21(static_cast<std::uint64_t>(std::clamp(unit, 0.0, 1.0) * 2097151.0)) << c;
+      // A non-finite coordinate goes to cell 0: its place is arbitrary but fixed (a NaN cast to
+      // an integer would be undefined).
+      const double cell = std::isfinite(unit) ? std::clamp(unit, 0.0, 1.0) * 2097151.0 : 0.0;
+      code |= morton_spread_21(static_cast<std::uint64_t>(cell)) << c;
     }
     keys[static_cast<std::size_t>(i)] = {code, i};
   });
