@@ -137,7 +137,9 @@ int main(int argc, char** argv) {
   nlohmann::json all = nlohmann::json::array();
   try {
     for (const std::string& path : meshes) {
-      const Mesh dense_mesh = read_mesh(path);
+      // D in the order `vertexflow lod` runs its chain in (lod.h, in_morton_order), for every
+      // method: each is measured against the same samples of D.
+      const Mesh dense_mesh = in_morton_order(read_mesh(path));
       const ReferenceSurface dense(dense_mesh.V, dense_mesh.F, path);
       const std::vector<Index> budgets = lod_face_budgets(dense_mesh.num_faces(), options);
       nlohmann::json rows = nlohmann::json::array();
