@@ -92,24 +92,26 @@ struct LodDistance {
 };
 
 struct LodLevelReport {
-  int level = 0;                ///< 1 for the first (finest) level
-  Index target_faces = 0;       ///< the level's face budget
-  Index input_faces = 0;        ///< faces of the mesh it was simplified from
-  Index faces = 0;              ///< faces of the level (target_faces or target_faces + 1, see simplify.h)
-  Index vertices = 0;           ///< vertices of the level
-  LodDistance qem;              ///< QEM alone, against D
-  LodDistance fitted;           ///< the fit (and flips), against D
-  bool kept_qem = false;        ///< the level is QEM alone: the fit measured a larger mean, or was skipped
-  bool fit_skipped = false;     ///< QEM alone is on D up to rounding: not fitted (fitted = qem)
-  double min_quality = 0;       ///< the smallest 2r/R of the level as kept
-  Index flipped_faces = 0;      ///< faces turned over from QEM to the fitted level
-  Index edge_flips = 0;         ///< edges flipped towards D (0 without LodOptions::edge_flips)
-  double simplify_seconds = 0;  ///< QEM
-  double fit_seconds = 0;       ///< the fit, flips and refits (enhance())
-  double measure_seconds = 0;   ///< both measurements against D
-  double seconds = 0;           ///< the level in all
-  SimplifyReport simplify;      ///< QEM's own report
-  nlohmann::json enhance;       ///< the fit's report (EnhanceResult::report)
+  int level = 0;             ///< 1 for the first (finest) level
+  Index target_faces = 0;    ///< the level's face budget
+  Index input_faces = 0;     ///< faces of the mesh it was simplified from
+  Index faces = 0;           ///< faces of the level (target_faces or target_faces + 1, see simplify.h)
+  Index vertices = 0;        ///< vertices of the level
+  LodDistance qem;           ///< QEM alone, against D
+  LodDistance fitted;        ///< the fit (and flips), against D
+  bool kept_qem = false;     ///< the level is QEM alone: the fit measured a larger mean, or was skipped
+  bool fit_skipped = false;  ///< QEM alone is on D up to rounding: not fitted (fitted = qem)
+  double min_quality = 0;    ///< the smallest 2r/R of the level as kept
+  Index flipped_faces = 0;   ///< faces turned over from QEM to the fitted level
+  Index edge_flips = 0;      ///< edges flipped towards D (0 without LodOptions::edge_flips)
+  /// QEM. From the second level of a chain on, QEM runs in the previous level's call, alongside
+  /// its measurement (lod_level): the phases' seconds overlap, and `seconds` does not count it.
+  double simplify_seconds = 0;
+  double fit_seconds = 0;      ///< the fit, flips and refits (enhance())
+  double measure_seconds = 0;  ///< both measurements against D
+  double seconds = 0;          ///< the lod_level call in all
+  SimplifyReport simplify;     ///< QEM's own report
+  nlohmann::json enhance;      ///< the fit's report (EnhanceResult::report)
 };
 
 struct LodLevel {
