@@ -112,6 +112,11 @@ class Collapser {
  public:
   Collapser(const Vertices& V, const Faces& F, bool keep_boundary) : keep_boundary_(keep_boundary) {
     const Index n = static_cast<Index>(V.rows());
+    // mesh.h's degenerate face: area below kDegenerateAreaRelative * diagonal^2, in terms of the
+    // squared norm of the cross product (twice the area).
+    const double diagonal_squared = n > 0 ? (V.colwise().maxCoeff() - V.colwise().minCoeff()).squaredNorm() : 0.0;
+    const double least_double_area = 2 * kDegenerateAreaRelative * diagonal_squared;
+    least_cross_squared_ = least_double_area * least_double_area;
     const Index m = static_cast<Index>(F.rows());
     position_.resize(static_cast<std::size_t>(n));
     for (Index v = 0; v < n; ++v) position_[static_cast<std::size_t>(v)] = V.row(v).transpose();
@@ -366,6 +371,11 @@ class Collapser {
         const double before_squared = before.squaredNorm();
         if (before_squared > 0 && (after.dot(before) <= 0 || after_squared < 1e-16 * before_squared))
           return reject(a, b);
+        // Nor does a face become degenerate as mesh.h (and so read_mesh, which removes such
+        // faces) counts it: in a flat subdivision whole rows of vertices lie on one line, and
+        // collapses along them left faces down to 1.3e-17 of the diagonal squared (84 of them at
+        // lod's first level of make_large_mesh's armadillo), which the relative test above let by.
+        if (after_squared < least_cross_squared_ && before_squared >= least_cross_squared_) return reject(a, b);
       }
     }
 
@@ -483,6 +493,7 @@ class Collapser {
   }
 
   bool keep_boundary_;
+  double least_cross_squared_ = 0;  // a face's squared cross product below this is degenerate
   std::vector<Vec3> position_;
   std::vector<Quadric> quadric_;
   std::vector<std::array<Index, 3>> face_;
