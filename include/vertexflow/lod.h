@@ -120,8 +120,9 @@ struct LodLevel {
   Mesh mesh;
   LodLevelReport report;
   /// `mesh` simplified to the next level's budget (lod_level's `next_target_faces`), for the next
-  /// lod_level to take as its `simplified`; empty when none was asked for, or when the level was
-  /// not fitted (the next lod_level then simplifies as usual).
+  /// lod_level to take as its `simplified`; empty when none was asked for, when the level was not
+  /// fitted or is QEM alone, or when that simplification failed (the next lod_level then
+  /// simplifies as usual).
   std::optional<SimplifyResult> next_simplified;
 };
 
@@ -141,10 +142,12 @@ std::vector<Index> lod_face_budgets(Index dense_faces, const LodOptions& options
 ///
 /// The chain's steps overlap where they can, and the results are the same bytes as one step
 /// after another. QEM runs on one thread, so the second core does other work meanwhile:
-/// - without `simplified`, D's tree and samples (ReferenceSurface) are built alongside QEM;
+/// - without `simplified`, D's tree and the measurements' samples of D (ReferenceSurface) are
+///   built alongside QEM;
 /// - with `next_target_faces` > 0, the fitted level is simplified to that budget alongside its
 ///   measurement, and returned as LodLevel::next_simplified. Where the measurement then keeps
-///   QEM alone (keep_better_of_two), that simplification is made again from QEM alone.
+///   QEM alone (keep_better_of_two), or that simplification fails, next_simplified is left
+///   empty, and the next lod_level simplifies the level as kept itself (and throws there).
 /// `simplified`, when given, is `previous` simplified to `target_faces` with `options` (the
 /// previous level's next_simplified) and takes the place of this level's QEM.
 ///
@@ -155,20 +158,22 @@ LodLevel lod_level(const Mesh& previous, const ReferenceSurface& dense, Index ta
                    const LodOptions& options = {}, const EnhanceCallbacks& callbacks = {}, Index next_target_faces = 0,
                    std::optional<SimplifyResult> simplified = std::nullopt);
 
-/// `mesh` with its vertices, then its faces (by centroid), sorted along a Morton curve in its
-/// bounding box, ties by index; each face keeps its corners' cyclic order, so its orientation.
-/// Comments are kept, attributes dropped (lod drops them). The order the chain runs in (lod()
-/// and `vertexflow lod`): the levels inherit D's order, and in a scattered order every tree
-/// query, tree build and solve of the chain misses the cache. Measured on the smooth 1M-vertex
-/// mesh of docs/lod.md (Loop-subdivided, so scattered), whole process, 3 runs each: 56.0-58.2 s
-/// in file order, 45.2-47.8 s in this one. The chain is then another one, as QEM breaks ties by
-/// vertex index and D's samples follow its face order: that mesh's gains per level moved by at
-/// most 0.3 points, both ways; docs/results_lod.md's averages by at most 0.4.
+/// `mesh` with its vertices sorted along a Morton curve in their bounding box, then its faces
+/// by their centroids along one in the centroids' box, ties by index; each face keeps its
+/// corners' cyclic order, so its orientation. Comments are kept, attributes dropped (lod drops
+/// them). The order the chain runs in (lod() and `vertexflow lod`): the levels inherit D's
+/// order, and in a scattered order every tree query, tree build and solve of the chain misses
+/// the cache. Measured on the smooth 1M-vertex mesh of docs/lod.md (Loop-subdivided, so
+/// scattered), whole process, 3 runs each: 56.0-58.2 s in file order, 45.2-47.8 s in this one.
+/// The chain is then another one, as QEM breaks ties by vertex index and D's samples follow its
+/// face order: that mesh's gains per level moved by at most 0.3 points, both ways;
+/// docs/results_lod.md's averages by at most 0.4.
 Mesh in_morton_order(const Mesh& mesh);
 
-/// The whole chain on D = in_morton_order(`dense`), whose ReferenceSurface it builds once. `on_level` (may be
-/// empty) is called as each level is finished, in order. Reports progress (progress.h): level i
-/// is the part [i - 1, i] / #levels of the task. Throws as lod_face_budgets and lod_level.
+/// The whole chain on D = in_morton_order(`dense`), whose ReferenceSurface it builds once.
+/// `on_level` (may be empty) is called as each level is finished, in order. Reports progress
+/// (progress.h): level i is the part [i - 1, i] / #levels of the task. Throws as
+/// lod_face_budgets and lod_level.
 std::vector<LodLevel> lod(const Mesh& dense, const LodOptions& options = {}, const EnhanceCallbacks& callbacks = {},
                           const std::function<void(const LodLevel&)>& on_level = {});
 /// The same with D's ReferenceSurface given (a front end that reads D once and names it), in the

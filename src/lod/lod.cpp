@@ -161,15 +161,20 @@ LodLevel lod_level(const Mesh& previous, const ReferenceSurface& dense, Index ta
         [&] {
           if (next_target_faces <= 0) return;
           const ProgressScope silent{ProgressSink{}};
-          out.next_simplified = simplify(fitted.mesh.V, fitted.mesh.F, simplify_options(next_target_faces, options));
+          // A failure here is the next level's, not this one's: it is left to the next
+          // lod_level, which simplifies as usual and throws there.
+          try {
+            out.next_simplified = simplify(fitted.mesh.V, fitted.mesh.F, simplify_options(next_target_faces, options));
+          } catch (const std::exception&) {
+            out.next_simplified.reset();
+          }
         });
     r.measure_seconds += measure_seconds;
 
     r.kept_qem = options.keep_better_of_two && r.fitted.mean > r.qem.mean;
-    if (r.kept_qem && out.next_simplified) {
-      const ProgressScope silent{ProgressSink{}};
-      out.next_simplified = simplify(qem.mesh.V, qem.mesh.F, simplify_options(next_target_faces, options));
-    }
+    // Made from the fitted level, which is not the one kept: the next lod_level simplifies QEM
+    // alone itself.
+    if (r.kept_qem) out.next_simplified.reset();
     out.mesh = r.kept_qem ? std::move(qem.mesh) : std::move(fitted.mesh);
   }
   r.faces = out.mesh.num_faces();

@@ -1,5 +1,7 @@
 #include "vertexflow/reference_surface.h"
 
+#include <tbb/task_group.h>
+
 #include <atomic>
 #include <map>
 #include <mutex>
@@ -7,6 +9,15 @@
 #include <tuple>
 
 namespace vertexflow {
+namespace {
+
+// What a build cut short by a cancelled task group throws; TBB rethrows the sibling's exception,
+// so this one is never seen.
+struct CancelledBuild : std::runtime_error {
+  CancelledBuild() : std::runtime_error("reference surface: a build was cancelled") {}
+};
+
+}  // namespace
 
 struct ReferenceSurface::Impl {
   Vertices V;
@@ -46,7 +57,12 @@ const std::string& ReferenceSurface::name() const {
 const DistanceQuery& ReferenceSurface::distance_query() const {
   std::call_once(impl_->tree_once, [this] {
     // Over the reference's own V and F, which live as long as the tree: no second copy.
-    impl_->tree = std::make_unique<DistanceQuery>(impl_->V, impl_->F, DistanceQuery::Borrow{});
+    auto tree = std::make_unique<DistanceQuery>(impl_->V, impl_->F, DistanceQuery::Borrow{});
+    // Called in a TBB task whose group is being cancelled (a sibling branch of a parallel_invoke
+    // threw), the build's own parallel loops return early without an error: that tree may be
+    // missing a part. Not kept, and not marked built, so the next call builds it whole.
+    if (tbb::is_current_task_group_canceling()) throw CancelledBuild();
+    impl_->tree = std::move(tree);
     ++impl_->trees_built;
   });
   return *impl_->tree;
@@ -63,6 +79,7 @@ const SurfaceSamples& ReferenceSurface::samples(const SamplingOptions& options) 
   // Drawn outside the lock (it takes a while on a dense S); a second caller with the same
   // options meanwhile draws the same samples, and the first stored is kept.
   SurfaceSamples drawn = sample_surface(impl_->V, impl_->F, options);
+  if (tbb::is_current_task_group_canceling()) throw CancelledBuild();  // as for the tree
   const std::lock_guard lock(impl_->samples_mutex);
   return impl_->samples.try_emplace(key, std::move(drawn)).first->second;
 }
