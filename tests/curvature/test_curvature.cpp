@@ -14,7 +14,6 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
-#include <numeric>
 #include <random>
 #include <vector>
 
@@ -405,23 +404,7 @@ TEST(Curvature, MatchesAPlainEigenReference) {
 // floating-point additions (and which SIMD lane and block computes a face), not the result.
 TEST(Curvature, IndependentOfVertexAndFaceOrder) {
   const Mesh mesh = read_mesh(test::data_path("armadillo-43k.obj"));
-  std::mt19937 rng(7);
-  std::vector<Index> new_index(static_cast<std::size_t>(mesh.num_vertices()));
-  std::iota(new_index.begin(), new_index.end(), 0);
-  std::shuffle(new_index.begin(), new_index.end(), rng);
-  std::vector<Index> face_order(static_cast<std::size_t>(mesh.num_faces()));
-  std::iota(face_order.begin(), face_order.end(), 0);
-  std::shuffle(face_order.begin(), face_order.end(), rng);
-  Mesh shuffled;
-  shuffled.V.resize(mesh.num_vertices(), 3);
-  for (Index v = 0; v < mesh.num_vertices(); ++v)
-    shuffled.V.row(new_index[static_cast<std::size_t>(v)]) = mesh.V.row(v);
-  shuffled.F.resize(mesh.num_faces(), 3);
-  for (Index f = 0; f < mesh.num_faces(); ++f) {
-    const Index source = face_order[static_cast<std::size_t>(f)];
-    for (int k = 0; k < 3; ++k)  // rotate the corners by f % 3 (same orientation)
-      shuffled.F(f, k) = new_index[static_cast<std::size_t>(mesh.F(source, (k + f) % 3))];
-  }
+  const auto [shuffled, new_index] = test::renumbered(mesh, 7, true);
   const Curvature c = principal_curvatures(mesh.V, mesh.F);
   const Curvature s = principal_curvatures(shuffled.V, shuffled.F);
   const double scale = c.k1.cwiseAbs().maxCoeff();

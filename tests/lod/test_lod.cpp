@@ -16,8 +16,6 @@
 
 #include <algorithm>
 #include <array>
-#include <numeric>
-#include <random>
 #include <set>
 #include <stdexcept>
 
@@ -54,18 +52,7 @@ TEST(LodBudgets, PercentAndFacesAndTheirErrors) {
 // the curve, from a mesh whose order was shuffled.
 TEST(LodOrder, SameTrianglesAlongTheCurve) {
   const Mesh sphere = test::icosphere(1.0, 4);
-  std::vector<Index> vertex_shuffle(static_cast<std::size_t>(sphere.num_vertices()));
-  std::iota(vertex_shuffle.begin(), vertex_shuffle.end(), Index{0});
-  std::mt19937 random(3);
-  std::shuffle(vertex_shuffle.begin(), vertex_shuffle.end(), random);
-  Mesh shuffled;
-  shuffled.V.resize(sphere.num_vertices(), 3);
-  for (Index v = 0; v < sphere.num_vertices(); ++v)
-    shuffled.V.row(vertex_shuffle[static_cast<std::size_t>(v)]) = sphere.V.row(v);
-  shuffled.F.resize(sphere.num_faces(), 3);
-  for (Index f = 0; f < sphere.num_faces(); ++f)
-    for (int c = 0; c < 3; ++c)
-      shuffled.F(sphere.num_faces() - 1 - f, c) = vertex_shuffle[static_cast<std::size_t>(sphere.F(f, c))];
+  Mesh shuffled = test::renumbered(sphere, 3, false).mesh;
   shuffled.comments = {"kept"};
   const Mesh ordered = in_morton_order(shuffled);
   // Each face as its corners' positions, rotated to start at its smallest: orientation kept.

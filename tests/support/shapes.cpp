@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <numeric>
 #include <random>
 #include <set>
 #include <vector>
@@ -42,6 +43,28 @@ void grid_triangles(int rows, int cols, const auto& index, std::vector<Eigen::Ve
 }
 
 }  // namespace
+
+Renumbered renumbered(const Mesh& mesh, unsigned seed, bool rotate_corners) {
+  std::mt19937 random(seed);
+  Renumbered out;
+  out.new_index.resize(static_cast<std::size_t>(mesh.num_vertices()));
+  std::iota(out.new_index.begin(), out.new_index.end(), Index{0});
+  std::shuffle(out.new_index.begin(), out.new_index.end(), random);
+  std::vector<Index> face_order(static_cast<std::size_t>(mesh.num_faces()));
+  std::iota(face_order.begin(), face_order.end(), Index{0});
+  std::shuffle(face_order.begin(), face_order.end(), random);
+  out.mesh.V.resize(mesh.num_vertices(), 3);
+  for (Index v = 0; v < mesh.num_vertices(); ++v)
+    out.mesh.V.row(out.new_index[static_cast<std::size_t>(v)]) = mesh.V.row(v);
+  out.mesh.F.resize(mesh.num_faces(), 3);
+  for (Index f = 0; f < mesh.num_faces(); ++f) {
+    const Index source = face_order[static_cast<std::size_t>(f)];
+    const Index turn = rotate_corners ? f % 3 : 0;
+    for (int k = 0; k < 3; ++k)
+      out.mesh.F(f, k) = out.new_index[static_cast<std::size_t>(mesh.F(source, (k + turn) % 3))];
+  }
+  return out;
+}
 
 Mesh flat_subdivision(const Mesh& mesh, int segments) {
   const Index n = segments;

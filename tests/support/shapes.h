@@ -47,6 +47,15 @@ Mesh roof(int n, bool across);
 /// Two triangles sharing only vertex 0 (a "bowtie"): the smallest non-manifold mesh.
 Mesh bowtie();
 
+/// `mesh` renumbered at random (std::mt19937 with `seed`): vertex v becomes new_index[v], the
+/// faces come in a shuffled order, and with `rotate_corners` face f of the result lists its
+/// corners rotated by f % 3 (the same orientation). The same surface, for order invariance.
+struct Renumbered {
+  Mesh mesh;
+  std::vector<Index> new_index;
+};
+Renumbered renumbered(const Mesh& mesh, unsigned seed, bool rotate_corners);
+
 /// Each face of `mesh` cut into segments^2 coplanar triangles on its barycentric lattice (a flat
 /// subdivision: the surface is unchanged, and the points of each input edge lie on one line).
 /// Points on a shared edge are shared; each new face keeps its input face's orientation.
