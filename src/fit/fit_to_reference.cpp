@@ -18,7 +18,6 @@
 #include <chrono>
 #include <cmath>
 #include <optional>
-#include <span>
 #include <stdexcept>
 #include <string>
 
@@ -55,20 +54,19 @@ double rows_to_mesh(const Vertices& X, const Faces& F, const Vertices& samples, 
                     QueryBuffers& buffers) {
   const DistanceQuery mesh(X, F, DistanceQuery::Borrow{});
   const Index count = samples.rows();
+  // No guesses (an empty list) in the first round, as in rows_to_reference.
   const bool guessed = to_mesh.size() == static_cast<std::size_t>(count);
-  if (guessed) {
-    buffers.near.resize(to_mesh.size());
+  buffers.near.resize(guessed ? to_mesh.size() : 0);
+  if (guessed)
     parallel_for_index(
         count, [&](Index j) { buffers.near[static_cast<std::size_t>(j)] = to_mesh[static_cast<std::size_t>(j)].face; });
-  }
   to_mesh.resize(static_cast<std::size_t>(count));
   buffers.squared.resize(static_cast<std::size_t>(count));
-  mesh.for_each_closest_point(samples, guessed ? std::span<const Index>(buffers.near) : std::span<const Index>(),
-                              [&](Index j, const ClosestPoint& foot) {
-                                to_mesh[static_cast<std::size_t>(j)] = {foot.face, F.row(foot.face).transpose(),
-                                                                        foot.barycentric, samples.row(j).transpose()};
-                                buffers.squared[static_cast<std::size_t>(j)] = foot.squared_distance;
-                              });
+  mesh.for_each_closest_point(samples, buffers.near, [&](Index j, const ClosestPoint& foot) {
+    to_mesh[static_cast<std::size_t>(j)] = {foot.face, F.row(foot.face).transpose(), foot.barycentric,
+                                            samples.row(j).transpose()};
+    buffers.squared[static_cast<std::size_t>(j)] = foot.squared_distance;
+  });
   const double sum_to_mesh =
       sum_over_vertices(count, 0.0, [&](Index j) { return buffers.squared[static_cast<std::size_t>(j)]; });
   return sum_to_mesh / static_cast<double>(count);

@@ -150,7 +150,7 @@ LodLevel lod_level(const Mesh& previous, const ReferenceSurface& dense, Index ta
     t = Clock::now();
     report_progress("measure", fit_end, 1);
     // The next level's QEM alongside the measurement, from the fitted level: the level kept
-    // unless the measurement says otherwise (then it is made again below). The measurement's
+    // unless the measurement says otherwise (then it is dropped below). The measurement's
     // seconds are its own, though they overlap QEM's.
     double measure_seconds = 0;
     tbb::parallel_invoke(
