@@ -12,6 +12,7 @@ packages=(
   libopenblas0-pthread     # threaded BLAS, only for the test that results do not depend on BLAS threads
   libtbb-dev               # parallel loops
   libcgal-dev              # polygon triangulation, AABB trees, remeshing, QEM
+  libboost-dev             # Boost headers used directly (the native QEM's d-ary heap); CGAL needs them too
   libgmp-dev libmpfr-dev   # CGAL's exact kernels
   libcli11-dev             # command-line parsing
   libfmt-dev               # formatting
