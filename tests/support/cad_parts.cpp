@@ -128,7 +128,8 @@ Mesh cad_perforated_plate(const CadPlateOptions& o) {
     holes.push_back(std::move(loop));
   }
 
-  // One planar face: the constrained Delaunay triangulation of the loops, no Steiner points.
+  // One face: the constrained Delaunay triangulation of the loops, without Steiner points on a
+  // flat plate.
   std::vector<Eigen::Vector2d> points;
   std::vector<std::vector<int>> loops;  // indices into points; loops[0] the outline
   Cdt cdt;
@@ -150,6 +151,23 @@ Mesh cad_perforated_plate(const CadPlateOptions& o) {
   for (const Loop& hole : holes) insert_loop(hole);
   if (cdt.number_of_vertices() != points.size())
     throw std::runtime_error("cad_perforated_plate: two loop points coincide");
+  if (o.bend_radius > 0) {
+    // A curved face's interior points: a grid in the face's parameters (arc length across the
+    // bend, length along the axis), kept where it is in the material and clear of every rim.
+    const double column = std::sqrt(8 * o.bend_radius * o.chord_tolerance);
+    const double row = o.row_spacing_factor * column;
+    const double clearance = std::max(o.spacing / 2, column / 4);
+    for (double u = -o.width / 2 + column / 2; u < o.width / 2; u += column)
+      for (double v = -o.height / 2 + row / 2; v < o.height / 2; v += row) {
+        const Eigen::Vector2d c(u, v);
+        bool free = inside_outline(c, clearance);
+        for (const Placed& p : placed) free = free && (p.centre - c).norm() >= p.reach + clearance;
+        if (!free) continue;
+        const Cdt::Vertex_handle h = cdt.insert(Kernel::Point_2(u, v));
+        h->info() = static_cast<int>(points.size());
+        points.push_back(c);
+      }
+  }
   mark_nesting(cdt);
   std::vector<std::array<int, 3>> cap;
   for (auto f = cdt.finite_faces_begin(); f != cdt.finite_faces_end(); ++f)
@@ -180,20 +198,23 @@ Mesh cad_perforated_plate(const CadPlateOptions& o) {
   for (const auto& f : faces)
     for (int k = 0; k < 3; ++k)
       if (f[k] < f[(k + 1) % 3]) edges.push_back({f[k], f[(k + 1) % 3]});
-  const auto planar = [&](int v) { return points[static_cast<std::size_t>(v % m)]; };
+  const auto position = [&](int v, double t) -> Eigen::Vector3d {
+    const Eigen::Vector2d& p = points[static_cast<std::size_t>(v % m)];
+    const double offset = v < m ? t / 2 : -t / 2;
+    if (o.bend_radius <= 0) return {p.x(), p.y(), offset};
+    const double r = o.bend_radius + offset, angle = p.x() / o.bend_radius;
+    return {r * std::sin(angle), p.y(), r * std::cos(angle) - o.bend_radius};
+  };
   double t = 1.0;
   for (int step = 0; step < 50; ++step) {
     double sum = 0;
-    for (const auto& e : edges) {
-      const double dz = (e[0] < m) == (e[1] < m) ? 0.0 : t;
-      sum += std::hypot((planar(e[0]) - planar(e[1])).norm(), dz);
-    }
+    for (const auto& e : edges) sum += (position(e[0], t) - position(e[1], t)).norm();
     t = o.thickness_in_edges * sum / static_cast<double>(edges.size());
   }
 
   Mesh mesh;
   mesh.V.resize(2 * m, 3);
-  for (int v = 0; v < 2 * m; ++v) mesh.V.row(v) << planar(v).x(), planar(v).y(), v < m ? t / 2 : -t / 2;
+  for (int v = 0; v < 2 * m; ++v) mesh.V.row(v) = position(v, t).transpose();
   mesh.F.resize(static_cast<Index>(faces.size()), 3);
   for (std::size_t f = 0; f < faces.size(); ++f)
     mesh.F.row(static_cast<Index>(f)) << faces[f][0], faces[f][1], faces[f][2];

@@ -30,11 +30,18 @@ struct CadPlateOptions {
   /// The plate's thickness as a fraction of the mesh's mean edge length (solved for: the walls'
   /// edges are part of the mean).
   double thickness_in_edges = 0.2;
+  /// 0: a flat plate. Otherwise the plate is a curved face: its mid-surface wrapped around a
+  /// cylinder of this radius (axis along y), its caps triangulated with interior points as
+  /// exporters place them on a curved face: columns `sqrt(8 R chord_tolerance)` apart across
+  /// the bend (the chord error), `row_spacing_factor` times that apart along the straight axis.
+  double bend_radius = 0;
+  double row_spacing_factor = 3;
   unsigned seed = 1;
 };
 
 /// A closed, oriented, manifold plate of genus `holes` (throws std::runtime_error if the holes
-/// do not fit).
+/// do not fit). Flat plates lie in z = +-t/2; bent ones between radii R -+ t/2 about the axis
+/// (x = 0, z = -R).
 Mesh cad_perforated_plate(const CadPlateOptions& options);
 
 }  // namespace vertexflow::test
