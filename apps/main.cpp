@@ -1,5 +1,6 @@
 // vertexflow: command-line interface. Each subcommand lives in its own command_*.cpp; this file
 // parses the command line and turns every error into one line on stderr and exit code 1.
+#include "allocator.h"
 #include "cli_common.h"
 
 #include <fmt/format.h>
@@ -24,7 +25,7 @@ int main(int argc, char** argv) {
   using namespace vertexflow::cli;
   CLI::App app{"vertexflow: enhance the shape features of triangle meshes by vertex flow"};
   app.require_subcommand(1);
-  app.set_version_flag("--version", "vertexflow 0.1.0");
+  app.set_version_flag("--version", "vertexflow 0.1.0\nallocator: " + allocator_description());
   GlobalOptions global;
   app.add_flag("-q,--quiet", global.quiet, "Print no warnings or progress")->configurable(false);
   app.fallthrough();

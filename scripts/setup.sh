@@ -12,6 +12,7 @@ packages=(
   libopenblas0-pthread     # threaded BLAS, only for the test that results do not depend on BLAS threads
   libtbb-dev               # parallel loops
   libcgal-dev              # polygon triangulation, AABB trees, remeshing, QEM
+  libjemalloc-dev          # the CLI's allocator, with transparent huge pages (apps/allocator.cpp)
   libboost-dev             # Boost headers used directly (the native QEM's d-ary heap); CGAL needs them too
   libgmp-dev libmpfr-dev   # CGAL's exact kernels
   libcli11-dev             # command-line parsing

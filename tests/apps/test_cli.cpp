@@ -294,6 +294,20 @@ TEST(Cli, UsageErrorsFail) {
   EXPECT_NE(version.out.find("vertexflow"), std::string::npos);
 }
 
+// The allocator the CLI was built with (apps/allocator.cpp). With jemalloc, huge pages are on
+// only if jemalloc read the options the binary defines: a malloc_conf it did not see (a symbol
+// not interposed) leaves opt.thp at "default", and the speed-up is gone.
+TEST(Cli, SaysWhichAllocatorItRunsOn) {
+  const auto version = run_cli("--version");
+  ASSERT_EQ(version.exit_code, 0);
+#if defined(VERTEXFLOW_CLI_WITH_JEMALLOC)
+  EXPECT_NE(version.out.find("allocator: jemalloc"), std::string::npos) << version.out;
+  EXPECT_NE(version.out.find("transparent huge pages: always"), std::string::npos) << version.out;
+#else
+  EXPECT_NE(version.out.find("allocator: the C library's malloc"), std::string::npos) << version.out;
+#endif
+}
+
 }  // namespace
 }  // namespace vertexflow
 
