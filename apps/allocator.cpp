@@ -6,9 +6,10 @@
 // faults of that first touch, 4 KiB at a time, were a quarter of the wall time: glibc's malloc
 // maps every large block afresh and this machine's kernel gives huge pages only to memory that
 // asks for them (transparent_hugepage=madvise). The same run with jemalloc asking for huge pages
-// (docs/benchmarks.md, "The allocator"): arm1m 10.75 -> 7.6 s, the same output bytes, peak RSS
-// +2.5%. The library itself does not choose an allocator; docs/benchmarks.md says how a program
-// or Python gets the same.
+// (docs/benchmarks.md, "The allocator"): arm1m 10.44 -> 8.48 s and a 9.7M-vertex mesh 215 ->
+// 116 s (medians, alternating with the C library's malloc), the same output bytes, about the same
+// peak RSS. The library itself does not choose an allocator; docs/benchmarks.md says how a
+// program or Python gets the same.
 #include "allocator.h"
 
 #include <string>
@@ -21,7 +22,7 @@
 // metadata_thp:auto its own bookkeeping once that is large. dirty_decay_ms:1000 returns freed
 // pages after a second instead of ten: a phase still reuses its own, and what the previous phase
 // freed is not held through the next one's peak; retain:false unmaps what it returns instead of
-// keeping it for reuse (arm1m's peak 752 -> 721 MB at the same speed). Both measured against
+// keeping it for reuse (arm1m's peak 752 -> 734 MB at the same speed). Both measured against
 // the defaults in docs/benchmarks.md, "The allocator".
 extern "C" {
 // NOLINTNEXTLINE: the name and type are jemalloc's interface.

@@ -21,9 +21,9 @@ namespace {
 // 10M with --report (there the report's metrics may be the peak), a slope of 730 B/vertex. The
 // report's metrics otherwise peak below the flow (843 against 1,014 MiB at 1M), so a report adds
 // nothing. A reference vertex costs its distance tree, curvature and copies. The CLI's jemalloc
-// with huge pages (apps/allocator.cpp) holds up to about 40 MB more, most visible on small
-// meshes (a 163,842-vertex sphere: 224.7 -> 265.7 MB; arm1m +19 MB, arm10m +85 MB): the fixed
-// part was 128 MiB before it.
+// with huge pages (apps/allocator.cpp) holds up to about 40 MB more on small meshes (a
+// 163,842-vertex sphere: 224.7 -> 265.7 MB with thp:always alone; at 1M within 15 MB either way,
+// at 10M 85 MB less): the fixed part was 128 MiB before it.
 constexpr double kFixedBytes = 176.0 * 1024 * 1024;
 constexpr double kBytesPerVertexMultilevel = 900;
 constexpr double kBytesPerVertexBlockJacobi = 750;
