@@ -66,66 +66,6 @@ Renumbered renumbered(const Mesh& mesh, unsigned seed, bool rotate_corners) {
   return out;
 }
 
-Mesh flat_subdivision(const Mesh& mesh, int segments) {
-  const Index n = segments;
-  std::vector<Eigen::RowVector3d> points;
-  // A lattice point by what defines it: (corner, -1, -1), (smaller end, larger end, steps from
-  // the smaller end) on an edge, or (-2 - face, i, j) inside a face; so neighbours share it.
-  std::map<std::array<Index, 3>, Index> index_of;
-  auto point = [&](const std::array<Index, 3>& key, const Eigen::RowVector3d& p) {
-    const auto [it, added] = index_of.emplace(key, static_cast<Index>(points.size()));
-    if (added) points.push_back(p);
-    return it->second;
-  };
-  std::vector<std::array<Index, 3>> faces;
-  for (Index f = 0; f < mesh.num_faces(); ++f) {
-    const std::array<Index, 3> c{mesh.F(f, 0), mesh.F(f, 1), mesh.F(f, 2)};
-    // Lattice point (i, j): barycentric ((n - i - j) / n, i / n, j / n) in (c0, c1, c2).
-    auto at = [&](Index i, Index j) {
-      const Index k = n - i - j;
-      const std::array<Index, 3> w{k, i, j};
-      int zeros = 0, only = 0;
-      for (int q = 0; q < 3; ++q)
-        if (w[static_cast<std::size_t>(q)] == 0)
-          ++zeros;
-        else
-          only = q;
-      if (zeros == 2)
-        return point({c[static_cast<std::size_t>(only)], -1, -1}, mesh.V.row(c[static_cast<std::size_t>(only)]));
-      if (zeros == 1) {
-        int a = -1, b = -1;
-        for (int q = 0; q < 3; ++q)
-          if (w[static_cast<std::size_t>(q)] != 0) (a < 0 ? a : b) = q;
-        Index va = c[static_cast<std::size_t>(a)], vb = c[static_cast<std::size_t>(b)];
-        Index steps = w[static_cast<std::size_t>(b)];  // from va towards vb
-        if (vb < va) {
-          std::swap(va, vb);
-          steps = n - steps;
-        }
-        const double t = static_cast<double>(steps) / static_cast<double>(n);
-        return point({va, vb, steps}, (1 - t) * mesh.V.row(va) + t * mesh.V.row(vb));
-      }
-      Eigen::RowVector3d p = Eigen::RowVector3d::Zero();
-      for (int q = 0; q < 3; ++q)
-        p += static_cast<double>(w[static_cast<std::size_t>(q)]) / static_cast<double>(n) *
-             mesh.V.row(c[static_cast<std::size_t>(q)]);
-      return point({-2 - f, i, j}, p);
-    };
-    for (Index i = 0; i < n; ++i)
-      for (Index j = 0; i + j < n; ++j) {
-        faces.push_back({at(i, j), at(i + 1, j), at(i, j + 1)});
-        if (i + j + 2 <= n) faces.push_back({at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
-      }
-  }
-  Mesh out;
-  out.V.resize(static_cast<Index>(points.size()), 3);
-  for (std::size_t v = 0; v < points.size(); ++v) out.V.row(static_cast<Index>(v)) = points[v];
-  out.F.resize(static_cast<Index>(faces.size()), 3);
-  for (std::size_t f = 0; f < faces.size(); ++f)
-    for (int k = 0; k < 3; ++k) out.F(static_cast<Index>(f), k) = faces[f][static_cast<std::size_t>(k)];
-  return out;
-}
-
 Mesh vertex_clustered(const Mesh& mesh, double cell) {
   std::map<std::array<long long, 3>, int> cluster_of_cell;
   std::vector<int> cluster(static_cast<std::size_t>(mesh.num_vertices()));

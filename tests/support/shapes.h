@@ -56,11 +56,6 @@ struct Renumbered {
 };
 Renumbered renumbered(const Mesh& mesh, unsigned seed, bool rotate_corners);
 
-/// Each face of `mesh` cut into segments^2 coplanar triangles on its barycentric lattice (a flat
-/// subdivision: the surface is unchanged, and the points of each input edge lie on one line).
-/// Points on a shared edge are shared; each new face keeps its input face's orientation.
-Mesh flat_subdivision(const Mesh& mesh, int segments);
-
 /// A thin perforated plate, a hard case for the flow (thin walls, sharp creases, high genus):
 /// (2 holes + 1)^2 unit cells in the xy-plane, every cell with odd row and column a square
 /// through-hole, `thickness` thick in z, each cell cut into `subdivisions`^2 quads (two
