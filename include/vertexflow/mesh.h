@@ -46,6 +46,12 @@ using Colors = Eigen::Matrix<std::uint8_t, Eigen::Dynamic, 3, Eigen::RowMajor>;
 /// when measuring a result (docs/metrics.md, "degenerate faces").
 inline constexpr double kDegenerateAreaRelative = 1e-12;
 
+/// That bound for a mesh whose bounding-box diagonal is `diagonal`: a face with a smaller area
+/// is degenerate.
+inline double degenerate_area_bound(double diagonal) {
+  return kDegenerateAreaRelative * diagonal * diagonal;
+}
+
 /// A triangle mesh with what it carries: texture coordinates, normals, colours, labels and any
 /// other property (attributes.h), and comment lines.
 struct Mesh {

@@ -158,7 +158,7 @@ GuardCriteria guard_criteria(const Vertices& before, const Faces& F, const Guard
       worst = std::min(worst, quality[f]);
     }
   }
-  GuardCriteria criteria{before, F, kDegenerateAreaRelative * diagonal * diagonal, Eigen::VectorXd(F.rows())};
+  GuardCriteria criteria{before, F, degenerate_area_bound(diagonal), Eigen::VectorXd(F.rows())};
   for (Index f = 0; f < F.rows(); ++f) {
     double floor = min_quality;
     for (int k = 0; k < 3; ++k) floor = std::min(floor, worst_around[static_cast<std::size_t>(F(f, k))]);

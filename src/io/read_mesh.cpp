@@ -256,7 +256,7 @@ Mesh soup_to_mesh(PolygonSoup&& soup, const std::string& name, ReadReport& repor
   if (!(diagonal <= kMaxDiagonal && diagonal >= kMinDiagonal))
     fail(name, fmt::format("bounding-box diagonal {:g} is outside the supported range [{:g}, {:g}]", diagonal,
                            kMinDiagonal, kMaxDiagonal));
-  const double min_area = kDegenerateAreaRelative * diagonal * diagonal;
+  const double min_area = degenerate_area_bound(diagonal);
 
   // Faces with a repeated index (fanning a polygon with a repeated corner makes them too),
   // duplicates and zero-area faces are removed, or with keep_face_list counted and kept.

@@ -43,8 +43,7 @@ std::vector<Index> flipped_faces(const Vertices& before, const Vertices& after, 
 }
 
 std::vector<Index> degenerate_faces(const Vertices& V, const Faces& F) {
-  const double diagonal = bounding_box(V).diagonal();
-  const double min_area = kDegenerateAreaRelative * diagonal * diagonal;
+  const double min_area = degenerate_area_bound(bounding_box(V).diagonal());
   std::vector<Index> out;
   for (Index f = 0; f < F.rows(); ++f) {
     if (0.5 * face_normal(V, F, f).norm() < min_area) out.push_back(f);

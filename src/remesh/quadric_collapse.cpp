@@ -112,10 +112,8 @@ class Collapser {
  public:
   Collapser(const Vertices& V, const Faces& F, bool keep_boundary) : keep_boundary_(keep_boundary) {
     const Index n = static_cast<Index>(V.rows());
-    // mesh.h's degenerate face: area below kDegenerateAreaRelative * diagonal^2, in terms of the
-    // squared norm of the cross product (twice the area).
-    const double diagonal = n > 0 ? bounding_box(V).diagonal() : 0.0;
-    const double least_double_area = 2 * kDegenerateAreaRelative * diagonal * diagonal;
+    // mesh.h's degenerate face, in terms of the squared norm of the cross product (twice the area).
+    const double least_double_area = 2 * degenerate_area_bound(n > 0 ? bounding_box(V).diagonal() : 0.0);
     least_cross_squared_ = least_double_area * least_double_area;
     const Index m = static_cast<Index>(F.rows());
     position_.resize(static_cast<std::size_t>(n));
