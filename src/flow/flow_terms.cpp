@@ -27,10 +27,10 @@ FlowTerms make_flow_terms(const Topology& topology, const std::vector<char>& fix
     Index* out = t.ring.data() + t.ring_start[static_cast<std::size_t>(k)];
     for (const Index* j = begin; j != end; ++j) *out++ = t.local[static_cast<std::size_t>(*j)];
   });
-  t.K.resize(n);
-  t.G.resize(n);
-  t.P.resize(n);
-  t.D.resize(n);
+  t.K.assign_zero(n);
+  t.G.assign_zero(n);
+  t.P.assign_zero(n);
+  t.D.assign_zero(n);
   t.smooth.resize(n);
   t.inv_degree.resize(n);
   t.rest.resize(n);
@@ -43,14 +43,15 @@ FlowTerms make_flow_terms(const Topology& topology, const std::vector<char>& fix
     const auto v = static_cast<std::size_t>(k);
     const Index i = t.original[v];
     const Eigen::Vector3d t1 = c.T1.row(i).transpose(), t2 = c.T2.row(i).transpose(), normal = c.N.row(i).transpose();
-    t.K[v] = Sym3f(Eigen::Matrix3d(std::abs(c.k1[i]) * t1 * t1.transpose() + std::abs(c.k2[i]) * t2 * t2.transpose()));
-    t.P[v] = Sym3f(Eigen::Matrix3d(w_em * (t1 * t1.transpose() + t2 * t2.transpose())));
+    t.K.set(v,
+            Sym3f(Eigen::Matrix3d(std::abs(c.k1[i]) * t1 * t1.transpose() + std::abs(c.k2[i]) * t2 * t2.transpose())));
+    t.P.set(v, Sym3f(Eigen::Matrix3d(w_em * (t1 * t1.transpose() + t2 * t2.transpose()))));
     Eigen::Matrix3d distance =
         w_sd * (distance_coefficient(frame.d, c.k1[i]) * t1 * t1.transpose() +
                 distance_coefficient(frame.d, c.k2[i]) * t2 * t2.transpose() + normal * normal.transpose());
     distance.diagonal().array() += w_pull;
     if (!frame.sliver_stiffness.empty()) distance += w_sliver * frame.sliver_stiffness[static_cast<std::size_t>(i)];
-    t.D[v] = Sym3f(distance);
+    t.D.set(v, Sym3f(distance));
     const Index degree = topology.valence(i);
     t.inv_degree[v] = degree > 0 ? 1.0 / degree : 0.0;
     t.smooth[v] = degree > 0 ? weights.mu * std::exp(-(std::abs(c.k1[i]) + std::abs(c.k2[i]))) / nv : 0.0;
@@ -67,7 +68,7 @@ FlowTerms make_flow_terms(const Topology& topology, const std::vector<char>& fix
     const auto [begin, end] = t.one_ring(i);
     Eigen::Matrix3d sum = static_cast<double>(end - begin) * t.K[static_cast<std::size_t>(i)].full();
     for (const Index* j = begin; j != end; ++j) sum += t.K[static_cast<std::size_t>(*j)].full();
-    t.G[static_cast<std::size_t>(i)] = Sym3f(sum);
+    t.G.set(static_cast<std::size_t>(i), Sym3f(sum));
   });
   return t;
 }

@@ -29,21 +29,21 @@ namespace vertexflow {
 
 /// The per-vertex factors of H and b in normalised units, over the vertices renumbered by
 /// `original` (local index -> mesh vertex; vertex_ordering.h: neighbours close in memory).
-/// K, G, P and D are computed in double and stored in float (Sym3f, block3.h): 96 bytes per
-/// vertex fewer through the solve, the flow's peak. H is then exactly the (symmetric, positive
-/// definite) matrix of factors rounded to 6e-8 relative. On the 1M armadillo the vertices moved
-/// by 1.7e-6 mean edge lengths on average, a tenth of what the solver's tolerance allows
-/// (docs/benchmarks.md, "Float factors").
+/// K, G, P and D are computed in double and stored in float (Sym3f in groups of four,
+/// Sym3fGroups, block3.h): 96 bytes per vertex fewer through the solve, the flow's peak. H is
+/// then exactly the (symmetric, positive definite) matrix of factors rounded to 6e-8 relative.
+/// On the 1M armadillo the vertices moved by 1.7e-6 mean edge lengths on average, a tenth of
+/// what the solver's tolerance allows (docs/benchmarks.md, "Float factors").
 struct FlowTerms {
   Index n = 0;
   std::vector<Index> original;          ///< local index -> mesh vertex
   std::vector<Index> local;             ///< mesh vertex -> local index
   std::vector<Index> ring_start, ring;  ///< one-rings in local indices
   std::vector<char> fixed;
-  std::vector<Sym3f> K;               ///< K_i
-  std::vector<Sym3f> G;               ///< diagonal block of G: deg(i) K_i + sum_j K_j
-  std::vector<Sym3f> P;               ///< 1/|E| times the tangent projector
-  std::vector<Sym3f> D;               ///< F_sd and the pull
+  Sym3fGroups K;                      ///< K_i
+  Sym3fGroups G;                      ///< diagonal block of G: deg(i) K_i + sum_j K_j
+  Sym3fGroups P;                      ///< 1/|E| times the tangent projector
+  Sym3fGroups D;                      ///< F_sd and the pull
   std::vector<double> smooth;         ///< S_i = mu mu_i / |V| (0 for an isolated vertex)
   std::vector<double> inv_degree;     ///< 1 / deg(i) (0 for an isolated vertex)
   std::vector<Eigen::Vector3d> rest;  ///< fairness target r_i
