@@ -12,7 +12,16 @@
 // .../multilevel force the solver, to compare the paths; the others use
 // LinearSolver::Automatic. Cases named .../density-30 add 30 density passes
 // (FlowOptions::density); "density_ms" is their time.
+//
+// Cases named operator/... time one product H x of the solve's operator (flow_operator.h) on
+// the mesh's first frame, the conjugate gradients' inner step, so that a change to the passes
+// is measured without the rest of the flow's noise:
+//   build/bin/bench_flow --benchmark_filter='operator/' --benchmark_repetitions=5
 #include "bench_support.h"
+#include "flow_operator.h"
+#include "flow_setup.h"
+#include "flow_terms.h"
+#include "numerics/vertex_ordering.h"
 
 #include "vertexflow/flow.h"
 #include "vertexflow/io.h"
@@ -138,7 +147,32 @@ void run(benchmark::State& state, const std::string& name, LinearSolver solver, 
   state.SetItemsProcessed(state.iterations() * input.num_vertices());  // vertices per second
 }
 
+// The solve's operator on `name`'s first frame (as FlowSystemSolver numbers the vertices),
+// applied to the normalised right-hand side.
+void run_operator(benchmark::State& state, const std::string& name) {
+  const Mesh& input = mesh(name);
+  const Topology topology = build_topology(input.F, input.num_vertices());
+  const FlowOptions options;
+  const FlowSetup setup = prepare_flow(input.V, input.F, topology, options);
+  const FlowFrame frame = flow_frame(setup.input, input.F, topology, options, setup.sliver_faces);
+  const FlowTerms terms = make_flow_terms(topology, setup.fixed, frame, options.weights,
+                                          breadth_first_order(topology, space_filling_order(frame.P)));
+  FlowOperator op(terms);
+  const BlockVector b = op.right_hand_side(to_local(terms, frame.P.data()));
+  const BlockVector x = b / b.norm();
+  BlockVector y(x.size());
+  op.apply(x, y);  // the caches' first touch outside the loop
+  for (auto _ : state) benchmark::DoNotOptimize(op.apply(x, y));
+  state.counters["vertices"] = static_cast<double>(input.num_vertices());
+  state.SetItemsProcessed(state.iterations() * input.num_vertices());
+}
+
 void register_cases() {
+  for (const std::string name : {"bunny_uniform.off", "amo.off", "armadillo-1M"})
+    benchmark::RegisterBenchmark(("operator/" + name).c_str(),
+                                 [name](benchmark::State& state) { run_operator(state, name); })
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
   // Table 1's meshes (torus, Max-Planck, spot, fandisk, horse at ~10k, bunny, armadillo), amo
   // (90k) as the ~100k case, the subdivided armadillo as the ~1M case.
   const std::vector<std::string> table = {"torus.obj",         "max-planck-5k.obj", "spot.obj",
