@@ -34,40 +34,24 @@ void parallel_rows(int rows, Body&& body) {
   parallel_for_index(rows, body, 128, kSerialBelow);
 }
 
-// The index of P^T: P's rows in order, so each row of R is sorted
-// and its blocks come in the order a transposed copy would hold them.
-TransposeIndex transpose_index(const BlockSparseMatrix& P) {
-  TransposeIndex R;
-  R.start.assign(static_cast<std::size_t>(P.cols) + 1, 0);
-  for (const int c : P.column) ++R.start[static_cast<std::size_t>(c) + 1];
-  std::partial_sum(R.start.begin(), R.start.end(), R.start.begin());
-  R.row.resize(P.column.size());
-  R.position.resize(P.column.size());
-  std::vector<int> fill(R.start.begin(), R.start.end() - 1);
-  for (int k = 0; k < P.rows; ++k)
-    for (int m = P.start[static_cast<std::size_t>(k)]; m < P.start[static_cast<std::size_t>(k) + 1]; ++m) {
+BlockSparseMatrix transpose(const BlockSparseMatrix& A) {
+  BlockSparseMatrix T;
+  T.rows = A.cols;
+  T.cols = A.rows;
+  T.start.assign(static_cast<std::size_t>(T.rows) + 1, 0);
+  for (const int c : A.column) ++T.start[static_cast<std::size_t>(c) + 1];
+  std::partial_sum(T.start.begin(), T.start.end(), T.start.begin());
+  T.column.resize(A.column.size());
+  T.block.resize(A.block.size());
+  std::vector<int> fill(T.start.begin(), T.start.end() - 1);
+  for (int k = 0; k < A.rows; ++k)  // rows in order, so each row of T is sorted
+    for (int m = A.start[static_cast<std::size_t>(k)]; m < A.start[static_cast<std::size_t>(k) + 1]; ++m) {
       const auto out =
-          static_cast<std::size_t>(fill[static_cast<std::size_t>(P.column[static_cast<std::size_t>(m)])]++);
-      R.row[out] = k;
-      R.position[out] = m;
+          static_cast<std::size_t>(fill[static_cast<std::size_t>(A.column[static_cast<std::size_t>(m)])]++);
+      T.column[out] = k;
+      T.block[out] = A.block[static_cast<std::size_t>(m)].transpose();
     }
-  return R;
-}
-
-// y = P^T x through the index.
-void multiply_transposed(const BlockSparseMatrix& P, const TransposeIndex& R, const Eigen::VectorXd& x,
-                         Eigen::VectorXd& y) {
-  y.resize(3 * static_cast<Eigen::Index>(P.cols));
-  parallel_rows(P.cols, [&](int i) {
-    Vector3 sum = Vector3::Zero();
-    for (int m = R.start[static_cast<std::size_t>(i)]; m < R.start[static_cast<std::size_t>(i) + 1]; ++m) {
-      // Transposed into a matrix first: Eigen's product with the transpose expression sums the
-      // terms in another order, and the bytes would change.
-      const Matrix3 block = P.block[static_cast<std::size_t>(R.position[static_cast<std::size_t>(m)])].transpose();
-      sum.noalias() += block * block_at(x, R.row[static_cast<std::size_t>(m)]);
-    }
-    block_at(y, i) = sum;
-  });
+  return T;
 }
 
 // The strong-connection graph of A's blocks, CSR.
@@ -286,7 +270,7 @@ namespace {
 // needs only: A P whole was as large as A, and beside A, P and R the peak of the hierarchy's
 // set-up. Each row of A P and each block of the product is summed in the order of the whole
 // product, so the result is the same.
-BlockSparseMatrix galerkin_product(const BlockSparseMatrix& A, const BlockSparseMatrix& P, const TransposeIndex& R) {
+BlockSparseMatrix galerkin_product(const BlockSparseMatrix& A, const BlockSparseMatrix& P, const BlockSparseMatrix& R) {
   std::vector<int> slot(static_cast<std::size_t>(A.rows), -1);  // row of A P -> its place in `ap`
   std::vector<int> needed;
   std::vector<std::vector<std::pair<int, Matrix3>>> ap;
@@ -296,7 +280,7 @@ BlockSparseMatrix galerkin_product(const BlockSparseMatrix& A, const BlockSparse
     for (const int k : needed) slot[static_cast<std::size_t>(k)] = -1;
     needed.clear();
     for (int m = R.start[static_cast<std::size_t>(i0)]; m < R.start[static_cast<std::size_t>(i1)]; ++m) {
-      const int k = R.row[static_cast<std::size_t>(m)];
+      const int k = R.column[static_cast<std::size_t>(m)];
       if (slot[static_cast<std::size_t>(k)] < 0) {
         slot[static_cast<std::size_t>(k)] = static_cast<int>(needed.size());
         needed.push_back(k);
@@ -319,12 +303,12 @@ BlockSparseMatrix galerkin_product(const BlockSparseMatrix& A, const BlockSparse
         });
   };
   return build_block_rows(
-      P.cols, P.cols,
+      R.rows, P.cols,
       [&](int i, BlockRowAccumulator& row) {
         for (int m = R.start[static_cast<std::size_t>(i)]; m < R.start[static_cast<std::size_t>(i) + 1]; ++m) {
-          const Matrix3 left = P.block[static_cast<std::size_t>(R.position[static_cast<std::size_t>(m)])].transpose();
+          const Matrix3& left = R.block[static_cast<std::size_t>(m)];
           for (const auto& [column, block] :
-               ap[static_cast<std::size_t>(slot[static_cast<std::size_t>(R.row[static_cast<std::size_t>(m)])])])
+               ap[static_cast<std::size_t>(slot[static_cast<std::size_t>(R.column[static_cast<std::size_t>(m)])])])
             row[column].noalias() += left * block;
         }
       },
@@ -361,7 +345,7 @@ AdditiveMultilevel::AdditiveMultilevel(BlockSparseMatrix A, int coarsest_unknown
         row[b].noalias() -= scale[static_cast<std::size_t>(b)] * (damped * A.block[static_cast<std::size_t>(m)]);
       }
     });
-    level.R = transpose_index(level.P);
+    level.R = transpose(level.P);
     BlockSparseMatrix coarse = galerkin_product(A, level.P, level.R);
     levels_.push_back(std::move(level));
     A = std::move(coarse);
@@ -386,7 +370,7 @@ void AdditiveMultilevel::apply(std::size_t index, const Eigen::VectorXd& b, Eige
   }
   const Level& level = levels_[index];
   Eigen::VectorXd restricted, coarse;
-  multiply_transposed(level.P, level.R, b, restricted);
+  level.R.multiply(b, restricted);
   apply(index + 1, restricted, coarse);
   level.P.multiply(coarse, x);
   parallel_rows(level.P.rows,

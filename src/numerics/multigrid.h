@@ -34,14 +34,6 @@ struct BlockSparseMatrix {
   void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
 };
 
-/// The transpose of a BlockSparseMatrix P as an index into P's blocks: row i holds, for m in
-/// [start[i], start[i+1]), the block P.block[position[m]] transposed, at column row[m] (P's
-/// row), columns increasing. The multilevel restriction R = P^T: storing its blocks again was
-/// 70 bytes per fine vertex at the multilevel path's peak (docs/benchmarks.md).
-struct TransposeIndex {
-  std::vector<int> start, row, position;
-};
-
 /// The blocks of one row under construction, keyed by column (a sparse accumulator):
 /// row[column] is the block, zero when first touched.
 class BlockRowAccumulator {
@@ -97,7 +89,7 @@ class AdditiveMultilevel {
   struct Level {
     std::vector<Eigen::Matrix3d> block_inverse;  // B_l
     BlockSparseMatrix P;                         // prolongation from the next level
-    TransposeIndex R;                            // restriction P^T
+    BlockSparseMatrix R;                         // P^T
   };
   void apply(std::size_t level, const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
 
