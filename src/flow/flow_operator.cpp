@@ -40,10 +40,9 @@ struct Local {
 // kernels are compiled twice (target_clones), for AVX2 and for the baseline, and the loader
 // picks one. Eigen cannot do this itself: its 3x3 products vectorise within one vertex, where
 // three entries fill neither a 2- nor a 4-wide register, so the passes spent most of their
-// arithmetic converting and multiplying scalars. One product H x on the 1M armadillo, best of 40
-// (a scratch timing of FlowOperator::apply against the one-vertex code, equal bytes): 27.5 ms
-// before, 22.7 ms with AVX2, 26.8 ms with the baseline clone. The rest of the passes is the
-// neighbours' gathers, which stay one vertex at a time.
+// arithmetic converting and multiplying scalars. One product H x (bench_flow's operator/
+// cases) is 5-30% faster on one core; on two it is within noise, since both cores then wait on
+// the neighbours' gathers, which stay one vertex at a time (docs/benchmarks.md).
 constexpr Index kGroup = Sym3fGroups::kWidth;
 constexpr Index kGroupsPerTask = 256;  // 1024 vertices, parallel_for_index's grain
 static_assert(kVerticesPerChunk % kGroup == 0, "chunks of the sum must hold whole groups");
