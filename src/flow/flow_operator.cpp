@@ -73,7 +73,7 @@ struct Sym3Lanes {
   out.y = m.xy * v.x + m.yy * v.y + m.yz * v.z;
   out.z = m.xz * v.x + m.yz * v.y + m.zz * v.z;
 }
-// Lane l of `v` from rows[3 l .. 3 l + 2] for l < count, zero after.
+// v's lanes from rows staged by put (x, y, z rows of kGroup lanes each).
 [[gnu::always_inline]] inline void load(Vec3Lanes& v, const double (&rows)[3][kGroup]) {
   std::memcpy(&v.x, rows[0], sizeof v.x);
   std::memcpy(&v.y, rows[1], sizeof v.y);
@@ -197,7 +197,7 @@ struct OperatorData {
       double* y = d.y + 3 * static_cast<std::ptrdiff_t>(first + l);
       if (t.fixed[static_cast<std::size_t>(first + l)]) {
         y[0] = y[1] = y[2] = 0;
-        total += 0.0;
+        total += 0.0;  // the one-vertex code added a fixed vertex's 0 too (it turns a -0 sum into +0)
       } else {
         store(y, out, l);
         total += dot[l];

@@ -66,11 +66,7 @@ class Sym3fGroups {
   };
 
   /// n blocks, all zero (the last group's unused lanes stay zero).
-  void assign_zero(std::size_t n) {
-    size_ = n;
-    groups_.assign((n + kWidth - 1) / kWidth, Group{});
-  }
-  [[nodiscard]] std::size_t size() const { return size_; }
+  void assign_zero(std::size_t n) { groups_.assign((n + kWidth - 1) / kWidth, Group{}); }
   [[nodiscard]] Sym3f operator[](std::size_t i) const {
     const Group& g = groups_[i / kWidth];
     const std::size_t l = i % kWidth;
@@ -87,7 +83,6 @@ class Sym3fGroups {
   [[nodiscard]] const Group& group(std::size_t g) const { return groups_[g]; }
 
  private:
-  std::size_t size_ = 0;
   std::vector<Group> groups_;
 };
 
