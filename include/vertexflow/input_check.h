@@ -32,6 +32,7 @@
 #pragma once
 
 #include "vertexflow/mesh.h"
+#include "vertexflow/topology.h"
 
 namespace vertexflow {
 
@@ -73,6 +74,9 @@ struct InputCheck {
 /// corners. Faces with a repeated vertex or zero area count in the quality share (their quality
 /// is 0) and not among the interior edges' faces. Throws std::invalid_argument
 /// for a threshold outside [0, 1].
-InputCheck check_input(const Vertices& V, const Faces& F, const InputCheckOptions& options = {});
+/// `topology`, when given, must be build_topology(F, V.rows()): the edges are then taken from it
+/// instead of found again, with the same result.
+InputCheck check_input(const Vertices& V, const Faces& F, const InputCheckOptions& options = {},
+                       const Topology* topology = nullptr);
 
 }  // namespace vertexflow

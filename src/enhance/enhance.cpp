@@ -588,7 +588,7 @@ EnhanceResult enhance_clean(const Mesh& mesh, const ReferenceSurface* reference,
     case EnhanceMode::Flow: {
       // The flow and its density passes slide the vertices over the input's facets: an input
       // whose vertices look off the true surface is held (input_check.h).
-      const InputCheck check = check_input(mesh.V, mesh.F);
+      const InputCheck check = check_input(mesh.V, mesh.F, {}, topology);
       const Hold hold =
           decide_hold(check.poor_face_fraction, check.sharp_edge_fraction, false, options.assume_on_surface);
       if (hold.held) {

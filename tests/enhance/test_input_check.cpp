@@ -12,12 +12,14 @@
 #include "vertexflow/io.h"
 #include "vertexflow/quality.h"
 #include "vertexflow/simplify.h"
+#include "vertexflow/topology.h"
 
 #include <CGAL/Simple_cartesian.h>
 #include <CGAL/Surface_mesh.h>
 #include <CGAL/subdivision_method_3.h>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <iostream>
 #include <string>
 #include <vector>
@@ -143,6 +145,43 @@ TEST(InputCheck, CountsPoorFacesAwayFromTheBoundary) {
   const InputCheck closed = check_input(spot.V, spot.F);
   EXPECT_EQ(closed.rim_faces, 0);
   EXPECT_EQ(closed.poor_face_fraction, summarize_quality(triangle_quality(spot.V, spot.F)).fraction_below_0_3);
+}
+
+// With the caller's topology the check takes the edges from it instead of finding them again:
+// every measure the same, on a closed mesh, one with a rim, a control mesh, a decimated mesh and
+// a non-manifold one (three faces on an edge: that topology is not used, the faces are).
+TEST(InputCheck, TopologyGivesTheSameMeasures) {
+  Mesh fan = test::height_field(1.0, 6, [](double x, double y) { return 0.3 * x * y; });
+  const Index apex = fan.num_vertices();
+  fan.V.conservativeResize(apex + 1, 3);
+  fan.V.row(apex) << 0.0, 0.0, 1.0;
+  const Topology grid = build_topology(fan.F, apex);
+  const auto interior = std::find(grid.edge_face_count.begin(), grid.edge_face_count.end(), 2);
+  ASSERT_NE(interior, grid.edge_face_count.end());
+  const Index e = static_cast<Index>(interior - grid.edge_face_count.begin());
+  fan.F.conservativeResize(fan.num_faces() + 1, 3);
+  fan.F.row(fan.num_faces() - 1) << grid.edges(e, 0), grid.edges(e, 1), apex;  // a third face on the edge
+  const Mesh cage = read_mesh(test::data_path("suzanne.obj"));
+  const std::vector<Mesh> meshes{read_mesh(test::data_path("spot.obj")),
+                                 test::height_field(1.0, 12, [](double x, double y) { return x * x - y * y; }), cage,
+                                 DecimatedSpot().input, fan};
+  for (std::size_t k = 0; k < meshes.size(); ++k) {
+    const Mesh& mesh = meshes[k];
+    const Topology topology = build_topology(mesh.F, mesh.num_vertices());
+    const InputCheck faces = check_input(mesh.V, mesh.F), edges = check_input(mesh.V, mesh.F, {}, &topology);
+    EXPECT_EQ(edges.poor_face_fraction, faces.poor_face_fraction) << k;
+    EXPECT_EQ(edges.interior_faces, faces.interior_faces) << k;
+    EXPECT_EQ(edges.rim_faces, faces.rim_faces) << k;
+    EXPECT_EQ(edges.sharp_edge_fraction, faces.sharp_edge_fraction) << k;
+    EXPECT_EQ(edges.interior_edges, faces.interior_edges) << k;
+    EXPECT_EQ(edges.reason, faces.reason) << k;
+    EXPECT_GT(faces.interior_edges, 0) << k;
+  }
+  // The cases differ where it matters: a rim, sharp edges, poor faces, a non-manifold edge.
+  EXPECT_GT(check_input(meshes[1].V, meshes[1].F).rim_faces, 0);
+  EXPECT_EQ(check_input(cage.V, cage.F).reason, HoldReason::ControlMesh);
+  EXPECT_EQ(check_input(meshes[3].V, meshes[3].F).reason, HoldReason::Decimated);
+  EXPECT_FALSE(build_topology(fan.F, fan.num_vertices()).non_manifold_edges.empty());
 }
 
 // The decimated input: the flow (and its density passes) and smooth mode hold it, saying why;
