@@ -1,7 +1,10 @@
 // Sharp features of a mesh (include/vertexflow/features.h).
 #include "vertexflow/features.h"
 
+#include "flow_setup.h"
+
 #include "common/bucket_by_key.h"
+#include "numerics/parallel.h"
 
 #include "vertexflow/curvature.h"
 
@@ -10,8 +13,9 @@
 
 namespace vertexflow {
 
-SurfaceFeatures detect_features(const Vertices& V, const Faces& F, const Topology& topology, double angle_degrees,
-                                const std::vector<std::array<Index, 2>>& crease_edges) {
+SurfaceFeatures detect_features_without_normals(const Vertices& V, const Faces& F, const Topology& topology,
+                                                double angle_degrees,
+                                                const std::vector<std::array<Index, 2>>& crease_edges) {
   SurfaceFeatures features;
   const auto num_edges = static_cast<std::size_t>(topology.num_edges());
   features.sharp_edge.assign(num_edges, 0);
@@ -33,16 +37,18 @@ SurfaceFeatures detect_features(const Vertices& V, const Faces& F, const Topolog
   }
   const double cosine = std::cos(angle_degrees * M_PI / 180.0);
   if (angle_degrees < 180) {
-    for (Index f = 0; f < F.rows(); ++f) {
+    // Each interior edge from its lower face only (not boundary edges: g = -1), so the faces
+    // can run in parallel: each edge's flag has one writer.
+    parallel_for_index(static_cast<Index>(F.rows()), [&](Index f) {
       for (int k = 0; k < 3; ++k) {
         const Index g = topology.face_adjacency(f, k);
-        if (g < f) continue;  // each interior edge once (and not boundary edges: g = -1)
+        if (g < f) continue;
         const Eigen::Vector3d nf = face_normal(V, F, f), ng = face_normal(V, F, g);
         const double product = nf.norm() * ng.norm();
         if (product > 0 && nf.dot(ng) < cosine * product)
           features.sharp_edge[static_cast<std::size_t>(topology.face_edges(f, k))] = 1;
       }
-    }
+    });
   }
   features.on_sharp_edge.assign(static_cast<std::size_t>(topology.num_vertices), 0);
   for (std::size_t e = 0; e < num_edges; ++e) {
@@ -125,7 +131,6 @@ SurfaceFeatures detect_features(const Vertices& V, const Faces& F, const Topolog
   });
   features.sharp_start = std::move(sharp.start);
   features.sharp_at = std::move(sharp.items);
-  features.vertex_normals = vertex_normals(V, F);
   features.vertex_kind.resize(n);
   for (std::size_t v = 0; v < n; ++v) {
     const auto count = static_cast<std::size_t>(features.sharp_count(static_cast<Index>(v)));
@@ -148,6 +153,13 @@ SurfaceFeatures detect_features(const Vertices& V, const Faces& F, const Topolog
         features.vertex_kind[v] = SurfaceFeatures::Kind::Corner;
     }
   }
+  return features;
+}
+
+SurfaceFeatures detect_features(const Vertices& V, const Faces& F, const Topology& topology, double angle_degrees,
+                                const std::vector<std::array<Index, 2>>& crease_edges) {
+  SurfaceFeatures features = detect_features_without_normals(V, F, topology, angle_degrees, crease_edges);
+  features.vertex_normals = vertex_normals(V, F);
   return features;
 }
 

@@ -202,6 +202,7 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
       const std::vector<ClosestPoint> feet = surface->query.closest_points(Y);
       for (const Index i : rows) Y.row(i) = feet[static_cast<std::size_t>(i)].point.transpose();
     } else {
+      restore_after_solve(setup, V, F);  // the features' normals, if no solve has restored them yet
       project_near_vertices(Y, rows, input, F, topology, setup.features);
     }
   };

@@ -62,8 +62,8 @@ FlowSetup prepare_flow(const Vertices& V, const Faces& F, const Topology& topolo
       fixed[static_cast<std::size_t>(i)] = 1;
   }
   for (const Index p : options.constraints.pinned) fixed[static_cast<std::size_t>(p)] = 1;
-  setup.features = detect_features(V, F, topology, options.project_to_input ? options.feature_angle : 180.0,
-                                   options.constraints.crease_edges);
+  setup.features = detect_features_without_normals(
+      V, F, topology, options.project_to_input ? options.feature_angle : 180.0, options.constraints.crease_edges);
   for (Index i = 0; i < n; ++i) {
     if (setup.features.vertex_kind[static_cast<std::size_t>(i)] == SurfaceFeatures::Kind::Corner)
       fixed[static_cast<std::size_t>(i)] = 1;

@@ -19,7 +19,8 @@ struct FlowSetup {
   /// energy terms but the pull), pinned vertices and the corners of the features.
   std::vector<char> fixed;
   /// Sharp features for options.feature_angle, or none without the projection (which is what
-  /// enforces them).
+  /// enforces them). Their vertex_normals stay empty until restore_after_solve: the solve, the
+  /// flow's peak, would free them anyway, and only the projection reads them.
   SurfaceFeatures features;
   /// The normalisation (flow.h, "Scale and rigid motion"): input = (V - centroid) / scale, with
   /// scale the mean edge length (1 if that is 0).
@@ -40,9 +41,15 @@ FlowSetup prepare_flow(const Vertices& V, const Faces& F, const Topology& topolo
 /// bytes and the reference is normalised as the input is.
 Vertices normalised(const Vertices& V, const FlowSetup& setup);
 
+/// detect_features without the vertex normals (empty): what prepare_flow needs.
+SurfaceFeatures detect_features_without_normals(const Vertices& V, const Faces& F, const Topology& topology,
+                                                double angle_degrees,
+                                                const std::vector<std::array<Index, 2>>& crease_edges = {});
+
 /// Frees what a solve does not read of `setup` (the normalised input and the features' vertex
 /// normals: 48 bytes per vertex at the solve, the flow's peak); restore_after_solve(setup, V, F)
-/// with prepare_flow's V and F computes them again, bit for bit.
+/// with prepare_flow's V and F computes what is missing of them, bit for bit (the normals
+/// detect_features would have computed). Call it before any projection.
 void release_during_solve(FlowSetup& setup);
 void restore_after_solve(FlowSetup& setup, const Vertices& V, const Faces& F);
 
