@@ -70,7 +70,10 @@ std::vector<int> aggregate_nodes(const std::vector<int>& start, const std::vecto
 
 /// The additive multilevel operator M = B_0 + P_1 (B_1 + P_2 (... + A_L^-1 ...) P_2^T) P_1^T,
 /// with B_l the inverses of level l's 3x3 diagonal blocks and A_L the coarsest Galerkin matrix,
-/// factored densely. M is symmetric positive definite, so it can precondition conjugate
+/// factored densely; where coarsening stalls on a level of more than max(coarsest_unknowns,
+/// 1,500) unknowns (its nodes mostly without strong neighbours, as when a mesh has thousands of
+/// separate components), A_L^-1 is replaced by A_L's block-Jacobi inverse, so that memory and
+/// time stay linear. M is symmetric positive definite, so it can precondition conjugate
 /// gradients. Deterministic, and the same for any thread count.
 class AdditiveMultilevel {
  public:
@@ -83,7 +86,9 @@ class AdditiveMultilevel {
   void apply(const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
 
   [[nodiscard]] int num_levels() const { return static_cast<int>(levels_.size()) + 1; }
-  [[nodiscard]] Eigen::Index coarsest_unknowns() const { return coarsest_factor_.rows(); }
+  [[nodiscard]] Eigen::Index coarsest_unknowns() const { return coarsest_unknowns_; }
+  /// Whether the coarsest level is factored (else it has its block-Jacobi inverse).
+  [[nodiscard]] bool coarsest_factored() const { return coarsest_block_inverse_.empty(); }
 
  private:
   struct Level {
@@ -94,7 +99,9 @@ class AdditiveMultilevel {
   void apply(std::size_t level, const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
 
   std::vector<Level> levels_;
+  Eigen::Index coarsest_unknowns_ = 0;
   Eigen::LLT<Eigen::MatrixXd> coarsest_factor_;
+  std::vector<Eigen::Matrix3d> coarsest_block_inverse_;  // instead of the factor, on a stalled large level
 };
 
 }  // namespace vertexflow
