@@ -185,6 +185,12 @@ BlockSparseMatrix symmetric_from_upper(const BlockSparseMatrix& upper) {
     S.start[k + 1] = S.start[k] + lower_count[k] + (upper.start[k + 1] - upper.start[k]);
   S.column.resize(static_cast<std::size_t>(S.start.back()));
   S.block.resize(static_cast<std::size_t>(S.start.back()));
+  // The blocks' pages first touched by all threads: touched by the serial transpose below,
+  // their faults took 2.7 s of the 10M-vertex run's main thread (a 1.8 GB matrix).
+  parallel_rows(S.rows, [&](int k) {
+    for (int m = S.start[static_cast<std::size_t>(k)]; m < S.start[static_cast<std::size_t>(k) + 1]; ++m)
+      S.block[static_cast<std::size_t>(m)].setZero();
+  });
   std::vector<int> fill(S.start.begin(), S.start.end() - 1);
   for (std::size_t r = 0; r < rows; ++r)  // rows in order, so each lower part is sorted
     for (int m = upper.start[r]; m < upper.start[r + 1]; ++m) {
