@@ -41,8 +41,9 @@ struct Local {
 // picks one. Eigen cannot do this itself: its 3x3 products vectorise within one vertex, where
 // three entries fill neither a 2- nor a 4-wide register, so the passes spent most of their
 // arithmetic converting and multiplying scalars. One product H x (bench_flow's operator/
-// cases) is 5-30% faster on one core; on two it is within noise, since both cores then wait on
-// the neighbours' gathers, which stay one vertex at a time (docs/benchmarks.md).
+// cases) is 5-30% faster on one core; on two it is within noise. Not for memory traffic: running
+// the three passes chunk by chunk, so that each reads the previous one's output from the cache,
+// gained nothing either (docs/benchmarks.md, twelfth session).
 constexpr Index kGroup = Sym3fGroups::kWidth;
 constexpr Index kGroupsPerTask = 256;  // 1024 vertices, parallel_for_index's grain
 static_assert(kVerticesPerChunk % kGroup == 0, "chunks of the sum must hold whole groups");
