@@ -2,9 +2,12 @@
 //
 // Distance A -> B: points on A (area-uniform samples, plus every vertex and every edge
 // midpoint of A, thinned evenly to a fixed count on large meshes), each measured to the exact
-// closest point on B's triangles. The closest
-// points come from CGAL's AABB tree (a bounding-volume hierarchy over B) with CGAL's exact
-// point-triangle projection, in double precision.
+// closest point on B's triangles. The closest points come from a bounding-box hierarchy over B
+// (ours, built on all threads: src/metrics/face_box_tree.h says why) with CGAL's exact
+// point-triangle projection, in double precision. Where several faces of B are equally close
+// the answer names the lowest-numbered one, so every answer is the smallest (squared distance,
+// face) over B's faces: it does not depend on the tree, on where a search starts or on the order
+// of the queries.
 //
 // Conventions
 // - Lengths are in the units of the meshes' coordinates; callers that want them relative to a
@@ -16,9 +19,9 @@
 //   area samples (samples = 0, or every face of A degenerate) mean and RMS are over all points.
 //   On a mesh with more vertices and edges than SamplingOptions::max_vertices_and_midpoints
 //   the maximum is over an even subset of them: an estimate from below, at a fixed cost.
-// - Memory: a tree takes about 68 bytes per face of B (its nodes and one 4-byte face index per
-//   triangle; triangles are read from V and F when visited), plus the copy of V and F unless it
-//   borrows them (DistanceQuery::Borrow).
+// - Memory: a tree takes about 26 bytes per face of B (a 64-byte node per two to three faces and
+//   one 4-byte face index per face; triangles are read from V and F when visited), plus the copy
+//   of V and F unless it borrows them (DistanceQuery::Borrow).
 // - Determinism: for a given seed the samples are the same on every run and for any number of
 //   threads (they are drawn in one sequential stream), and the parallel queries run in fixed
 //   blocks with sums taken in a fixed order, so every figure is bit-identical for 1 or more
@@ -90,7 +93,7 @@ struct ClosestPoint {
 /// tree of it (reference_surface.h).
 std::uint64_t distance_trees_built(Index num_faces);
 
-/// Closest-point queries against a fixed mesh B: an AABB tree built once, then queried any
+/// Closest-point queries against a fixed mesh B: a box tree built once, then queried any
 /// number of times, from any number of threads. Holds its own copy of B's vertices and faces,
 /// or borrows the caller's.
 class DistanceQuery {
@@ -112,8 +115,8 @@ class DistanceQuery {
   DistanceQuery(const DistanceQuery&) = delete;
   DistanceQuery& operator=(const DistanceQuery&) = delete;
 
-  /// The closest point of B to p. Where several points of B are equally close (p on the
-  /// medial axis, or the closest point on an edge shared by two faces) any one of them.
+  /// The closest point of B to p. Where several faces of B are equally close (p on the medial
+  /// axis, or the closest point on an edge shared by two faces) the lowest-numbered one's.
   [[nodiscard]] ClosestPoint closest_point(const Eigen::Vector3d& p) const;
 
   /// closest_point for every row of P, in parallel (TBB); the same result for any number of
@@ -122,8 +125,8 @@ class DistanceQuery {
 
   /// The same with a guess per point: near_faces[i] is a face of B near row i's answer (its
   /// answer in an earlier query of a nearby point, say), or -1 for none. The search starts from
-  /// that face, which prunes more of the tree when the guess is good; the distances are the same,
-  /// and so are the answers except where two faces are equally close. Throws
+  /// that face, which prunes more of the tree when the guess is good; the answers are the same.
+  /// Throws
   /// std::invalid_argument unless near_faces is empty (no guesses) or has one entry per row of P,
   /// each below B's face count.
   [[nodiscard]] std::vector<ClosestPoint> closest_points(const Vertices& P, std::span<const Index> near_faces) const;
@@ -150,7 +153,7 @@ class DistanceQuery {
   [[nodiscard]] const Vertices& vertices() const;
   [[nodiscard]] const Faces& faces() const;
 
-  /// The bytes this query holds: its trees' nodes and primitives (about 68 per face), and its
+  /// The bytes this query holds: its tree's nodes and face order (about 26 per face), and its
   /// copy of B's V and F unless they are borrowed. Borrowed V and F are not counted.
   [[nodiscard]] std::size_t memory_bytes() const;
 

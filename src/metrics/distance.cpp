@@ -1,15 +1,13 @@
-// Mesh-to-mesh distances (include/vertexflow/distance.h): CGAL's AABB tree for the closest
+// Mesh-to-mesh distances (include/vertexflow/distance.h): our face box tree
+// (metrics/face_box_tree.h) for the search, CGAL's point-triangle projection for the closest
 // points, TBB for the parallel queries.
 #include "vertexflow/distance.h"
 
 #include "common/bucket_by_key.h"
+#include "metrics/face_box_tree.h"
 #include "numerics/vertex_ordering.h"
 
-#include <CGAL/AABB_traits.h>
-#include <CGAL/AABB_tree.h>
 #include <CGAL/Simple_cartesian.h>
-
-#include <boost/iterator/counting_iterator.hpp>
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -19,6 +17,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <mutex>
 #include <numeric>
@@ -35,7 +34,7 @@ namespace {
 using Kernel = CGAL::Simple_cartesian<double>;
 using Triangle = Kernel::Triangle_3;
 
-// The mesh a tree is over (not owned): the primitives' shared data.
+// The mesh a tree is over (not owned).
 struct MeshFaces {
   const Vertices* V = nullptr;
   const Faces* F = nullptr;
@@ -46,33 +45,11 @@ struct MeshFaces {
   [[nodiscard]] Triangle triangle(Index f) const { return {corner(f, 0), corner(f, 1), corner(f, 2)}; }
 };
 
-// A primitive is a face index; its triangle is read from V and F when the tree needs it. A
-// tree of CGAL's AABB_triangle_primitive over an array of Triangle_3 held that array (72 bytes
-// per face) and an iterator per primitive besides the copy of V and F: 390 bytes per vertex
-// with the nodes, against about 136 now, and the builds sort 4-byte primitives. The reference
-// point (the first corner, as AABB_triangle_primitive's) and the boxes are the same, so the
-// tree and every answer are too. (Primitives holding their triangle, CacheDatum true, made the
-// build twice as slow: 80-byte primitives to sort.)
-class FacePrimitive {
- public:
-  using Id = Index;
-  using Point = Kernel::Point_3;
-  using Datum = Triangle;
-  using Shared_data = MeshFaces;
-
-  FacePrimitive() = default;
-  template <class Iterator>
-  FacePrimitive(Iterator face, const MeshFaces& /*mesh*/) : face_(static_cast<Index>(*face)) {}
-
-  [[nodiscard]] Id id() const { return face_; }
-  [[nodiscard]] Datum datum(const MeshFaces& mesh) const { return mesh.triangle(face_); }
-  [[nodiscard]] Point reference_point(const MeshFaces& mesh) const { return mesh.corner(face_, 0); }
-  static MeshFaces construct_shared_data(const MeshFaces& mesh) { return mesh; }
-
- private:
-  Index face_ = -1;
+// A closest point and its face (-1: none yet).
+struct Answer {
+  Kernel::Point_3 point{0, 0, 0};
+  Index face = -1;
 };
-using Tree = CGAL::AABB_tree<CGAL::AABB_traits<Kernel, FacePrimitive>>;
 
 // Squared distance from p to an axis-aligned box (0 inside).
 inline double squared_distance_to_box(const Kernel::Point_3& p, const CGAL::Bbox_3& box) {
@@ -81,55 +58,6 @@ inline double squared_distance_to_box(const Kernel::Point_3& p, const CGAL::Bbox
   const double dz = std::max(0.0, std::max(box.zmin() - p.z(), p.z() - box.zmax()));
   return dx * dx + dy * dy + dz * dz;
 }
-
-// Closest-point search over CGAL's tree with CGAL's point-triangle projection, driven by
-// AABB_tree::traversal_with_priority (marked internal, present throughout CGAL 5.x). It finds
-// the same distance as AABB_tree::closest_point_and_primitive (where two triangles are equally
-// close it may name the other one) with less work: CGAL's own traits visit both children in a
-// fixed order, test each box by constructing a sphere, and project every triangle of a leaf
-// pair; here the nearer child is visited first, boxes are tested by their squared distance,
-// and a triangle whose bounding box is already further than the best point so far is not
-// projected. On the 100k-vertex benchmark (bench/bench_compare.cpp) projections took 42% and
-// the traversal 40% of CGAL's query time; these traits halve it.
-class ClosestPointTraits {
- public:
-  using Priority = double;  // minus the squared distance to the box: nearer first
-
-  ClosestPointTraits(const Kernel::Point_3& query, const Tree::Point_and_primitive_id& hint, const MeshFaces& mesh)
-      : best_(hint), best_d2_(CGAL::squared_distance(query, hint.first)), mesh_(mesh) {}
-
-  [[nodiscard]] bool go_further() const { return true; }
-
-  void intersection(const Kernel::Point_3& query, const FacePrimitive& primitive) {
-    const Triangle t = mesh_.triangle(primitive.id());
-    if (squared_distance_to_box(query, t.bbox()) >= best_d2_) return;
-    const Kernel::Point_3 closest = Kernel().construct_projected_point_3_object()(t, query);
-    const double d2 = CGAL::squared_distance(query, closest);
-    if (d2 < best_d2_) {
-      best_ = {closest, primitive.id()};
-      best_d2_ = d2;
-    }
-  }
-
-  template <class Node>
-  [[nodiscard]] bool do_intersect(const Kernel::Point_3& query, const Node& node) const {
-    return squared_distance_to_box(query, node.bbox()) < best_d2_;
-  }
-
-  template <class Node>
-  [[nodiscard]] std::pair<bool, Priority> do_intersect_with_priority(const Kernel::Point_3& query,
-                                                                     const Node& node) const {
-    const double d2 = squared_distance_to_box(query, node.bbox());
-    return {d2 < best_d2_, -d2};
-  }
-
-  [[nodiscard]] const Tree::Point_and_primitive_id& result() const { return best_; }
-
- private:
-  Tree::Point_and_primitive_id best_;
-  double best_d2_;
-  const MeshFaces& mesh_;
-};
 
 // Queries run in blocks of this many points. A block's first query starts from the guess of
 // the tree's k-d tree, each later one from the triangle of the previous answer (consecutive
@@ -182,15 +110,11 @@ void sort_along_morton_curve(Vertices& P, std::int64_t first, std::int64_t count
   auto rows = P.middleRows(first, count);
   const Eigen::RowVector3d low = rows.colwise().minCoeff(), high = rows.colwise().maxCoeff();
   const Eigen::RowVector3d scale = (high - low).cwiseMax(1e-300).cwiseInverse() * 2097151.0;
-  // A cell of the 2^21 grid; a non-finite coordinate goes to cell 0 (its order is then arbitrary
-  // but fixed).
-  const auto cell = [](double t) { return t >= 0 ? static_cast<std::uint64_t>(std::min(t, 2097151.0)) : 0; };
   std::vector<std::pair<std::uint64_t, std::int64_t>> key(static_cast<std::size_t>(count));
   tbb::parallel_for(tbb::blocked_range<std::int64_t>(0, count, 4096), [&](const tbb::blocked_range<std::int64_t>& r) {
     for (std::int64_t i = r.begin(); i != r.end(); ++i) {
       const Eigen::RowVector3d t = (rows.row(i) - low).cwiseProduct(scale);
-      key[static_cast<std::size_t>(i)] = {
-          morton_spread_21(cell(t.x())) | morton_spread_21(cell(t.y())) << 1 | morton_spread_21(cell(t.z())) << 2, i};
+      key[static_cast<std::size_t>(i)] = {morton_code_of_cells(t.x(), t.y(), t.z()), i};
     }
   });
   // The keys are unique (each carries its row), so the order is the same for any thread count.
@@ -351,64 +275,66 @@ SurfaceSamples sample_surface(const Vertices& V, const Faces& F, const SamplingO
 // ---------------------------------------------------------------------------------------------
 // Closest points
 
-// Meshes with at least this many faces get two trees, over the two halves of the faces split at
-// the median of their centroids along the longest side of the bounding box, built in parallel:
-// CGAL builds a tree on one thread. On 1.1M faces (bunny.off subdivided) one tree took 0.75 s,
-// two halves 0.53 s on 2 cores; a query searches the tree whose box is nearer first, and the
-// other is then mostly pruned at its root. The split does not depend on the thread count.
-constexpr Index kTwoTreesFrom = 200000;
-
 struct DistanceQuery::Impl {
   Vertices own_V;  // the copy, unless borrowed
   Faces own_F;
-  MeshFaces mesh;           // own_V and own_F, or the caller's
-  std::vector<Tree> trees;  // over two halves of the faces (kTwoTreesFrom), or all of them
+  MeshFaces mesh;  // own_V and own_F, or the caller's
+  FaceBoxTree tree;
 
-  Tree::Point_and_primitive_id closest(const Kernel::Point_3& q, const Tree::Point_and_primitive_id& hint) const {
-    ClosestPointTraits traits(q, hint, mesh);
-    if (trees.size() == 1) {
-      trees[0].traversal_with_priority(q, traits);
-    } else {
-      const bool second_first =
-          squared_distance_to_box(q, trees[1].bbox()) < squared_distance_to_box(q, trees[0].bbox());
-      trees[second_first ? 1 : 0].traversal_with_priority(q, traits);
-      trees[second_first ? 0 : 1].traversal_with_priority(q, traits);
-    }
-    return traits.result();
+  // The closest point of B to q, starting from `hint` (a point of its face, or no face). Of
+  // equally close faces the lowest-numbered one, so the answer is the smallest (squared
+  // distance, face) over all faces, whatever the tree, the hint or the thread: the tree visits
+  // every box within the best distance so far, including those exactly at it.
+  Answer closest(const Kernel::Point_3& q, const Answer& hint) const {
+    Answer best = hint;
+    double best_d2 = hint.face >= 0 ? CGAL::squared_distance(q, hint.point) : std::numeric_limits<double>::infinity();
+    const double at[3] = {q.x(), q.y(), q.z()};
+    tree.search(at, best_d2, [&](Index f) {
+      const Triangle t = mesh.triangle(f);
+      // A face whose own box is further than the best point cannot hold a nearer one.
+      if (squared_distance_to_box(q, t.bbox()) > best_d2 * FaceBoxTree::kRoundingSlack) return;
+      const Kernel::Point_3 closest = Kernel().construct_projected_point_3_object()(t, q);
+      const double d2 = CGAL::squared_distance(q, closest);
+      if (d2 < best_d2 || (d2 == best_d2 && f < best.face)) {
+        best = {closest, f};
+        best_d2 = d2;
+      }
+    });
+    return best;
   }
-  [[nodiscard]] Tree::Point_and_primitive_id any_hint(const Kernel::Point_3& q) const { return trees[0].best_hint(q); }
 
   // Counts the tree (distance_trees_built) and builds it over (V, F), which must outlive it.
-  void build_trees(const Vertices& V, const Faces& F);
+  void build_tree(const Vertices& V, const Faces& F);
 
-  // Runs fn(point index, query point, CGAL answer) for the rows [first, last) of P, in fixed
-  // blocks (see kQueryBlock). With skip_at_most >= 0, a point whose first guess is already
-  // within that squared distance is skipped (its distance cannot exceed it): for maxima.
-  // `near_faces`, when given, names a face of B near each point's answer (or -1): the search
-  // starts from that face instead of the previous point's.
+  // Runs fn(point index, query point, answer) for the rows [first, last) of P, in fixed blocks
+  // (see kQueryBlock). With skip_at_most >= 0, a point whose first guess is already within that
+  // squared distance is skipped (its distance cannot exceed it): for maxima. `near_faces`, when
+  // given, names a face of B near each point's answer (or -1): the search starts from that face
+  // instead of the previous point's.
   template <class Fn>
   void for_each_closest(const Vertices& P, std::size_t first, std::size_t last, double skip_at_most, Fn&& fn,
                         const Index* near_faces = nullptr) const {
     const std::size_t blocks = (last - first + kQueryBlock - 1) / kQueryBlock;
+    const auto project = [this](Index face, const Kernel::Point_3& q) {
+      return Answer{Kernel().construct_projected_point_3_object()(mesh.triangle(face), q), face};
+    };
     tbb::parallel_for(
         tbb::blocked_range<std::size_t>(0, blocks, 1),
         [&](const tbb::blocked_range<std::size_t>& range) {
           for (std::size_t block = range.begin(); block != range.end(); ++block) {
             const std::size_t begin = first + block * kQueryBlock, end = std::min(last, begin + kQueryBlock);
-            Tree::Point_and_primitive_id hint;
+            Answer hint;
             for (std::size_t i = begin; i < end; ++i) {
               const Kernel::Point_3 q = to_cgal(P.row(static_cast<Eigen::Index>(i)).transpose());
               if (near_faces && near_faces[i] >= 0) {
-                hint.second = near_faces[i];
-                hint.first = Kernel().construct_projected_point_3_object()(mesh.triangle(hint.second), q);
-              } else if (i == begin) {
-                hint = any_hint(q);
-              } else {
+                hint = project(near_faces[i], q);
+              } else if (hint.face >= 0) {
                 // Start from the closest point of the previous answer's triangle: a tighter
                 // first bound than the previous closest point itself.
-                hint.first = Kernel().construct_projected_point_3_object()(mesh.triangle(hint.second), q);
+                hint = project(hint.face, q);
               }
-              if (skip_at_most >= 0 && CGAL::squared_distance(q, hint.first) <= skip_at_most) continue;
+              if (skip_at_most >= 0 && hint.face >= 0 && CGAL::squared_distance(q, hint.point) <= skip_at_most)
+                continue;
               hint = closest(q, hint);
               fn(i, q, hint);
             }
@@ -422,11 +348,11 @@ struct DistanceQuery::Impl {
     for_each_closest(P, 0, static_cast<std::size_t>(P.rows()), -1.0, std::forward<Fn>(fn));
   }
 
-  ClosestPoint make_answer(const Kernel::Point_3& q, const Tree::Point_and_primitive_id& answer) const {
+  ClosestPoint make_answer(const Kernel::Point_3& q, const Answer& answer) const {
     ClosestPoint c;
-    c.point = to_eigen(answer.first);
-    c.squared_distance = CGAL::squared_distance(q, answer.first);
-    c.face = answer.second;
+    c.point = to_eigen(answer.point);
+    c.squared_distance = CGAL::squared_distance(q, answer.point);
+    c.face = answer.face;
     const Vertices& V = *mesh.V;
     const Faces& F = *mesh.F;
     c.barycentric = barycentric(c.point, V.row(F(c.face, 0)), V.row(F(c.face, 1)), V.row(F(c.face, 2)));
@@ -456,57 +382,22 @@ DistanceQuery::DistanceQuery(const Vertices& V, const Faces& F) : impl_(std::mak
   check_indices(V, F, "DistanceQuery");
   impl_->own_V = V;
   impl_->own_F = F;
-  impl_->build_trees(impl_->own_V, impl_->own_F);
+  impl_->build_tree(impl_->own_V, impl_->own_F);
 }
 
 DistanceQuery::DistanceQuery(const Vertices& V, const Faces& F, Borrow) : impl_(std::make_unique<Impl>()) {
   if (F.rows() == 0) throw std::invalid_argument("DistanceQuery: the mesh has no faces");
   check_indices(V, F, "DistanceQuery");
-  impl_->build_trees(V, F);
+  impl_->build_tree(V, F);
 }
 
-void DistanceQuery::Impl::build_trees(const Vertices& V, const Faces& F) {
+void DistanceQuery::Impl::build_tree(const Vertices& V, const Faces& F) {
   {
     const std::lock_guard lock(trees_mutex);
     ++trees_by_size()[static_cast<Index>(F.rows())];
   }
   mesh = {&V, &F};
-  const Index nf = static_cast<Index>(F.rows());
-  // No k-d tree of reference points for hints (CGAL builds one by default, lazily on the first
-  // query, serialising the threads): queries run in blocks where each point starts from the
-  // previous point's answer, so only a block's first query would use it. It cost 0.8 s of the
-  // 2.3 s build for 1.1M triangles.
-  const auto build_tree = [this](Tree& tree, auto first, auto last) {
-    tree.insert(first, last, mesh);
-    tree.do_not_accelerate_distance_queries();
-    tree.build();
-  };
-  if (nf < kTwoTreesFrom) {
-    trees.resize(1);
-    build_tree(trees[0], boost::counting_iterator<Index>(0), boost::counting_iterator<Index>(nf));
-    return;
-  }
-  // The median split (kTwoTreesFrom), ties broken by face index.
-  const Eigen::RowVector3d low = V.colwise().minCoeff(), high = V.colwise().maxCoeff();
-  Eigen::Index axis = 0;
-  (high - low).maxCoeff(&axis);
-  std::vector<double> key(static_cast<std::size_t>(nf));
-  tbb::parallel_for(tbb::blocked_range<Index>(0, nf), [&](const tbb::blocked_range<Index>& r) {
-    for (Index f = r.begin(); f != r.end(); ++f)
-      key[static_cast<std::size_t>(f)] = V(F(f, 0), axis) + V(F(f, 1), axis) + V(F(f, 2), axis);
-  });
-  std::vector<Index> face_of(static_cast<std::size_t>(nf));
-  std::iota(face_of.begin(), face_of.end(), Index{0});
-  const auto split = face_of.begin() + nf / 2;
-  std::nth_element(face_of.begin(), split, face_of.end(), [&](Index a, Index b) {
-    const double ka = key[static_cast<std::size_t>(a)], kb = key[static_cast<std::size_t>(b)];
-    return ka < kb || (ka == kb && a < b);
-  });
-  std::vector<double>().swap(key);
-  trees.resize(2);
-  const std::vector<Index>& order = face_of;
-  tbb::parallel_invoke([&] { build_tree(trees[0], order.begin(), order.begin() + nf / 2); },
-                       [&] { build_tree(trees[1], order.begin() + nf / 2, order.end()); });
+  tree = FaceBoxTree(V, F);
 }
 
 DistanceQuery::~DistanceQuery() = default;
@@ -514,14 +405,8 @@ DistanceQuery::DistanceQuery(DistanceQuery&&) noexcept = default;
 DistanceQuery& DistanceQuery::operator=(DistanceQuery&&) noexcept = default;
 
 std::size_t DistanceQuery::memory_bytes() const {
-  // An AABB_tree of n primitives holds them in one vector and n - 1 nodes in another (CGAL 5.5).
-  using Node = CGAL::AABB_node<CGAL::AABB_traits<Kernel, FacePrimitive>>;
-  std::size_t bytes = sizeof(Impl) + impl_->trees.size() * sizeof(Tree);
-  for (const Tree& tree : impl_->trees)
-    bytes += tree.size() * sizeof(FacePrimitive) + (tree.size() > 0 ? tree.size() - 1 : 0) * sizeof(Node);
-  bytes += static_cast<std::size_t>(impl_->own_V.size()) * sizeof(double) +
-           static_cast<std::size_t>(impl_->own_F.size()) * sizeof(Index);
-  return bytes;
+  return sizeof(Impl) + impl_->tree.memory_bytes() + static_cast<std::size_t>(impl_->own_V.size()) * sizeof(double) +
+         static_cast<std::size_t>(impl_->own_F.size()) * sizeof(Index);
 }
 
 const Vertices& DistanceQuery::vertices() const {
@@ -533,7 +418,7 @@ const Faces& DistanceQuery::faces() const {
 
 ClosestPoint DistanceQuery::closest_point(const Eigen::Vector3d& p) const {
   const Kernel::Point_3 q = to_cgal(p);
-  return impl_->make_answer(q, impl_->closest(q, impl_->any_hint(q)));
+  return impl_->make_answer(q, impl_->closest(q, Answer{}));
 }
 
 std::vector<ClosestPoint> DistanceQuery::closest_points(const Vertices& P) const {
@@ -556,9 +441,7 @@ std::vector<ClosestPoint> DistanceQuery::closest_points(const Vertices& P, std::
   std::vector<ClosestPoint> out(static_cast<std::size_t>(P.rows()));
   impl_->for_each_closest(
       P, 0, static_cast<std::size_t>(P.rows()), -1.0,
-      [&](std::size_t i, const Kernel::Point_3& q, const Tree::Point_and_primitive_id& a) {
-        out[i] = impl_->make_answer(q, a);
-      },
+      [&](std::size_t i, const Kernel::Point_3& q, const Answer& a) { out[i] = impl_->make_answer(q, a); },
       near_faces.empty() ? nullptr : near_faces.data());
   return out;
 }
@@ -568,7 +451,7 @@ void DistanceQuery::for_each_closest_point(const Vertices& P, std::span<const In
   check_near_faces(P, near_faces, static_cast<Index>(impl_->mesh.F->rows()));
   impl_->for_each_closest(
       P, 0, static_cast<std::size_t>(P.rows()), -1.0,
-      [&](std::size_t i, const Kernel::Point_3& q, const Tree::Point_and_primitive_id& a) {
+      [&](std::size_t i, const Kernel::Point_3& q, const Answer& a) {
         visit(static_cast<Index>(i), impl_->make_answer(q, a));
       },
       near_faces.empty() ? nullptr : near_faces.data());
@@ -576,8 +459,8 @@ void DistanceQuery::for_each_closest_point(const Vertices& P, std::span<const In
 
 Eigen::VectorXd DistanceQuery::squared_distances(const Vertices& P) const {
   Eigen::VectorXd out(P.rows());
-  impl_->for_each_closest(P, [&](std::size_t i, const Kernel::Point_3& q, const Tree::Point_and_primitive_id& a) {
-    out[static_cast<Eigen::Index>(i)] = CGAL::squared_distance(q, a.first);
+  impl_->for_each_closest(P, [&](std::size_t i, const Kernel::Point_3& q, const Answer& a) {
+    out[static_cast<Eigen::Index>(i)] = CGAL::squared_distance(q, a.point);
   });
   return out;
 }
@@ -590,9 +473,9 @@ double DistanceQuery::max_squared_distance(const Vertices& P, Index first_row, d
   // the order of the slots.
   std::vector<double> block_max((last - first + kQueryBlock - 1) / kQueryBlock, at_least);
   impl_->for_each_closest(P, first, last, std::max(at_least, 0.0),
-                          [&](std::size_t i, const Kernel::Point_3& q, const Tree::Point_and_primitive_id& a) {
+                          [&](std::size_t i, const Kernel::Point_3& q, const Answer& a) {
                             double& slot = block_max[(i - first) / kQueryBlock];
-                            slot = std::max(slot, CGAL::squared_distance(q, a.first));
+                            slot = std::max(slot, CGAL::squared_distance(q, a.point));
                           });
   return std::accumulate(block_max.begin(), block_max.end(), at_least,
                          [](double a, double b) { return std::max(a, b); });
@@ -634,13 +517,15 @@ SymmetricDistance symmetric_distance(const DistanceStats& a_to_b, const Distance
 
 SymmetricDistance symmetric_distance(const Vertices& VA, const Faces& FA, const Vertices& VB, const Faces& FB,
                                      const SamplingOptions& options) {
-  // Small meshes: both directions at once, as their tree builds and sampling are serial. Large
-  // ones: one after the other, so that one tree is alive at a time (their builds are parallel,
-  // kTwoTreesFrom). Each direction's figures do not depend on the schedule.
+  // Small meshes: both directions at once, as their sampling is partly serial and their tree
+  // builds split into few tasks. Large ones (200,000 faces or more): one after the other, so that
+  // one tree is alive at a time (each build and sampling has work enough for every thread). Each
+  // direction's figures do not depend on the schedule.
+  constexpr Index kOneTreeAtATimeFrom = 200000;
   DistanceStats a_to_b, b_to_a;
   const auto a_to_b_task = [&] { a_to_b = one_sided_distance(VA, FA, VB, FB, options); };
   const auto b_to_a_task = [&] { b_to_a = one_sided_distance(VB, FB, VA, FA, options); };
-  if (FA.rows() < kTwoTreesFrom && FB.rows() < kTwoTreesFrom) {
+  if (FA.rows() < kOneTreeAtATimeFrom && FB.rows() < kOneTreeAtATimeFrom) {
     tbb::parallel_invoke(a_to_b_task, b_to_a_task);
   } else {
     a_to_b_task();

@@ -8,6 +8,7 @@
 #include "vertexflow/mesh.h"
 #include "vertexflow/topology.h"
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -22,6 +23,15 @@ inline std::uint64_t morton_spread_21(std::uint64_t v) {
   v = (v | v << 4) & 0x10c30c30c30c30c3ULL;
   v = (v | v << 2) & 0x1249249249249249ULL;
   return v;
+}
+
+/// The Morton code of a point given in grid units, t = (p - low) * 2097151 / (high - low) per
+/// axis: each coordinate's cell of the 2^21 grid, clamped to it; a negative or non-finite
+/// coordinate goes to cell 0 (an arbitrary but fixed place: a NaN cast to an integer would be
+/// undefined).
+inline std::uint64_t morton_code_of_cells(double tx, double ty, double tz) {
+  const auto cell = [](double t) { return t >= 0 ? static_cast<std::uint64_t>(std::min(t, 2097151.0)) : 0; };
+  return morton_spread_21(cell(tx)) | morton_spread_21(cell(ty)) << 1 | morton_spread_21(cell(tz)) << 2;
 }
 
 /// Vertices sorted by the Morton code of their position (21 bits per axis), ties by index.

@@ -112,9 +112,9 @@ TEST(DistanceQuery, MatchesBruteForceOnSmallMeshes) {
   }
 }
 
-// From 200k faces the query splits the faces into two trees (distance.cpp): the answers are
-// still exact, name the input's faces, and do not depend on the thread count.
-TEST(DistanceQuery, MatchesBruteForceOnALargeMeshOfTwoTrees) {
+// A large mesh's tree is built by parallel tasks (face_box_tree.cpp, from 16,384 faces a range):
+// the answers are still exact, name the input's faces, and do not depend on the thread count.
+TEST(DistanceQuery, MatchesBruteForceOnALargeMeshBuiltInParallel) {
   const Mesh mesh = test::torus(1.0, 0.3, 500, 201);  // 201,000 faces
   ASSERT_GE(mesh.num_faces(), 200000);
   const DistanceQuery query(mesh.V, mesh.F);
@@ -140,6 +140,39 @@ TEST(DistanceQuery, MatchesBruteForceOnALargeMeshOfTwoTrees) {
   for (std::size_t i = 0; i < closest.size(); ++i) {
     EXPECT_EQ(one_thread[i].face, closest[i].face);
     EXPECT_EQ(one_thread[i].point, closest[i].point);
+  }
+}
+
+// Where faces are equally close the answer is the lowest-numbered of them, whatever the hint:
+// every face of a torus listed twice (f and f + n) ties with its copy, and each answer names
+// the first copy, also when the search starts from the second. Listing the faces in another
+// order changes the distances by rounding at most: a point closest to an edge or a vertex ties
+// between the faces around it, and the lowest-numbered one is then another triangle (the points
+// differed by at most 4.2e-17 of the diagonal here).
+TEST(DistanceQuery, EqualDistancesGoToTheLowestFace) {
+  const Mesh mesh = test::torus(1.0, 0.3, 60, 25);
+  const Index n = mesh.num_faces();
+  Faces twice(2 * n, 3);
+  twice << mesh.F, mesh.F;
+  const DistanceQuery query(mesh.V, twice);
+  const Vertices P = query_points(mesh, 400, 11);
+  const std::vector<ClosestPoint> plain = query.closest_points(P);
+  std::vector<Index> second_copies(static_cast<std::size_t>(P.rows()));
+  for (std::size_t i = 0; i < plain.size(); ++i) second_copies[i] = plain[i].face + n;
+  const std::vector<ClosestPoint> hinted = query.closest_points(P, second_copies);
+  for (std::size_t i = 0; i < plain.size(); ++i) {
+    ASSERT_LT(plain[i].face, n) << i;
+    EXPECT_EQ(hinted[i].face, plain[i].face) << i;
+    EXPECT_EQ(hinted[i].squared_distance, plain[i].squared_distance) << i;
+  }
+  // The faces reversed: face f is n - 1 - f.
+  const Faces reversed = mesh.F.colwise().reverse();
+  const std::vector<ClosestPoint> single = DistanceQuery(mesh.V, mesh.F).closest_points(P);
+  const std::vector<ClosestPoint> backwards = DistanceQuery(mesh.V, reversed).closest_points(P);
+  const double scale = bounding_box(mesh.V).diagonal();
+  for (std::size_t i = 0; i < single.size(); ++i) {
+    EXPECT_NEAR(std::sqrt(backwards[i].squared_distance), std::sqrt(single[i].squared_distance), 2e-16 * scale) << i;
+    EXPECT_NEAR((backwards[i].point - single[i].point).norm(), 0.0, 2e-16 * scale) << i;
   }
 }
 
@@ -258,17 +291,18 @@ TEST(DistanceQuery, BorrowedMeshGivesTheSameAnswers) {
   }
 }
 
-// What a query reports it holds (issue 29: the reference's memory is reported): its trees, at
-// 68 bytes per face on this build (CGAL 5.5: a 4-byte primitive and a 64-byte node per face),
-// plus its own copy of V and F, which a borrowing query does not count; and a reference
+// What a query reports it holds (issue 29: the reference's memory is reported): its tree, a
+// 64-byte node per inner node (fewer than half as many as faces, leaves holding up to four) and a
+// 4-byte face index per face: measured 25.5 and 26.8 bytes per face here. Plus its own copy of V
+// and F, which a borrowing query does not count; and a reference
 // surface adds its tree and samples once they exist.
 TEST(DistanceQuery, ReportsTheMemoryItHolds) {
   for (const Mesh& mesh : {test::icosphere(1.0, 3), test::torus(1.0, 0.3, 500, 201)}) {
     const DistanceQuery copied(mesh.V, mesh.F);
     const DistanceQuery borrowed(mesh.V, mesh.F, DistanceQuery::Borrow{});
     const double per_face = static_cast<double>(borrowed.memory_bytes()) / static_cast<double>(mesh.num_faces());
-    EXPECT_GT(per_face, 60.0);
-    EXPECT_LT(per_face, 80.0);
+    EXPECT_GT(per_face, 15.0);
+    EXPECT_LT(per_face, 40.0);
     EXPECT_EQ(copied.memory_bytes() - borrowed.memory_bytes(),
               static_cast<std::size_t>(mesh.V.size()) * sizeof(double) +
                   static_cast<std::size_t>(mesh.F.size()) * sizeof(Index));
