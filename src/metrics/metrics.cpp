@@ -2,30 +2,72 @@
 
 #include "numerics/parallel.h"
 
-#include <tbb/parallel_sort.h>
-
 #include <algorithm>
+#include <array>
+#include <bit>
 #include <cmath>
+#include <cstdint>
+#include <memory>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace vertexflow {
 namespace {
 
-// Ranks 1..n, ties sharing their average rank. The pairs (value, index) sorted in parallel:
-// the order a stable sort by value gives (a serial one took 4 s of 10M vertices' 9 s of rho).
+// The values in increasing order, ties (equal bits) in index order: an LSD radix sort of the
+// doubles' bits mapped to unsigned integers of the same order (negatives' bits inverted, the
+// sign bit set on the others), 11 bits a pass, passes on which every key has the same digit
+// skipped. Written here because neither TBB nor the standard library has a radix sort: with the
+// CLI's allocator (jemalloc, huge pages) spearman_correlation of two 10M-value vectors took
+// 1.5 s with a parallel comparison sort of (value, index) pairs, 0.8 s with this one on one
+// thread. Returns the indices in that order.
+std::vector<std::uint32_t> order_by_value(const Eigen::VectorXd& x) {
+  const std::size_t n = static_cast<std::size_t>(x.size());
+  constexpr int kBits = 11, kPasses = (64 + kBits - 1) / kBits;
+  constexpr std::size_t kBuckets = std::size_t{1} << kBits;
+  // Not zero-filled: every slot is written before it is read.
+  auto key = std::make_unique_for_overwrite<std::uint64_t[]>(n);
+  auto key_out = std::make_unique_for_overwrite<std::uint64_t[]>(n);
+  auto index = std::make_unique_for_overwrite<std::uint32_t[]>(n);
+  auto index_out = std::make_unique_for_overwrite<std::uint32_t[]>(n);
+  std::vector<std::array<std::size_t, kBuckets>> count(kPasses);
+  for (auto& c : count) c.fill(0);
+  for (std::size_t i = 0; i < n; ++i) {
+    const auto bits = std::bit_cast<std::uint64_t>(x[static_cast<Eigen::Index>(i)]);
+    key[i] = bits >> 63 ? ~bits : bits | std::uint64_t{1} << 63;
+    index[i] = static_cast<std::uint32_t>(i);
+    for (int pass = 0; pass < kPasses; ++pass)
+      ++count[static_cast<std::size_t>(pass)][key[i] >> (pass * kBits) & (kBuckets - 1)];
+  }
+  for (int pass = 0; pass < kPasses; ++pass) {
+    auto& c = count[static_cast<std::size_t>(pass)];
+    if (std::find(c.begin(), c.end(), n) != c.end()) continue;  // one digit for all: nothing moves
+    std::size_t start = 0;
+    for (std::size_t& bucket : c) start += std::exchange(bucket, start);
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::size_t to = c[key[i] >> (pass * kBits) & (kBuckets - 1)]++;
+      key_out[to] = key[i];
+      index_out[to] = index[i];
+    }
+    key.swap(key_out);
+    index.swap(index_out);
+  }
+  return {index.get(), index.get() + n};
+}
+
+// Ranks 1..n, ties sharing their average rank.
 Eigen::VectorXd ranks(const Eigen::VectorXd& x) {
   const Eigen::Index n = x.size();
-  std::vector<std::pair<double, Eigen::Index>> order(static_cast<std::size_t>(n));
-  for (Eigen::Index i = 0; i < n; ++i) order[static_cast<std::size_t>(i)] = {x[i], i};
-  tbb::parallel_sort(order.begin(), order.end());
+  const std::vector<std::uint32_t> order = order_by_value(x);
+  const auto value = [&](Eigen::Index k) { return x[order[static_cast<std::size_t>(k)]]; };
   Eigen::VectorXd r(n);
   for (Eigen::Index i = 0; i < n;) {
     Eigen::Index j = i;
-    while (j + 1 < n && order[static_cast<std::size_t>(j + 1)].first == order[static_cast<std::size_t>(i)].first) ++j;
+    while (j + 1 < n && value(j + 1) == value(i)) ++j;
     const double average = 0.5 * static_cast<double>(i + j) + 1.0;
-    for (Eigen::Index k = i; k <= j; ++k) r[order[static_cast<std::size_t>(k)].second] = average;
+    for (Eigen::Index k = i; k <= j; ++k) r[order[static_cast<std::size_t>(k)]] = average;
     i = j + 1;
   }
   return r;
