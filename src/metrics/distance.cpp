@@ -295,7 +295,9 @@ struct DistanceQuery::Impl {
       if (squared_distance_to_box(q, t.bbox()) > best_d2 * FaceBoxTree::kRoundingSlack) return;
       const Kernel::Point_3 closest = Kernel().construct_projected_point_3_object()(t, q);
       const double d2 = CGAL::squared_distance(q, closest);
-      if (d2 < best_d2 || (d2 == best_d2 && f < best.face)) {
+      // The first face visited is taken whatever its distance, so that a query whose distances
+      // are all NaN or infinite (a non-finite point or mesh) still names a face.
+      if (best.face < 0 || d2 < best_d2 || (d2 == best_d2 && f < best.face)) {
         best = {closest, f};
         best_d2 = d2;
       }

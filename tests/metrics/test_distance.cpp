@@ -17,6 +17,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <set>
 #include <stdexcept>
@@ -333,6 +334,26 @@ TEST(DistanceQuery, DegenerateTriangleIsItsLongestEdge) {
   const ClosestPoint c = query.closest_point({0.5, 0, 2});
   EXPECT_NEAR(c.barycentric.sum(), 1.0, 1e-15);
   EXPECT_GE(c.barycentric.minCoeff(), 0.0);
+}
+
+// A non-finite query point has no closest point, but the answer still names one of the mesh's
+// faces (no out-of-range face for the caller to index with).
+TEST(DistanceQuery, NonFinitePointsNameAFace) {
+  const Mesh mesh = test::icosphere(1.0, 2);
+  const DistanceQuery query(mesh.V, mesh.F);
+  for (const double bad : {std::nan(""), std::numeric_limits<double>::infinity()}) {
+    const ClosestPoint c = query.closest_point(Eigen::Vector3d(bad, 0.0, 0.0));
+    EXPECT_GE(c.face, 0);
+    EXPECT_LT(c.face, mesh.num_faces());
+    Vertices P(3, 3);
+    P << 0.2, 0.1, 0.9, bad, bad, bad, 0.0, 0.0, 2.0;
+    const std::vector<ClosestPoint> all = query.closest_points(P);
+    for (const ClosestPoint& a : all) {
+      EXPECT_GE(a.face, 0);
+      EXPECT_LT(a.face, mesh.num_faces());
+    }
+    EXPECT_NEAR(std::sqrt(all[2].squared_distance), 1.0, 0.05);  // (0, 0, 2) is about 1 from the sphere
+  }
 }
 
 TEST(DistanceQuery, RejectsEmptyAndBadMeshes) {
