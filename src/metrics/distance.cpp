@@ -59,10 +59,11 @@ inline double squared_distance_to_box(const Kernel::Point_3& p, const CGAL::Bbox
   return dx * dx + dy * dy + dz * dz;
 }
 
-// Queries run in blocks of this many points. A block's first query starts from the guess of
-// the tree's k-d tree, each later one from the triangle of the previous answer (consecutive
-// points are close: samples are sorted along a Morton curve, edges by vertex); fixed blocks
-// make the answers independent of how TBB schedules them.
+// Queries run in blocks of this many points. A block's first query searches the whole tree,
+// each later one starts from the triangle of the previous answer (consecutive points are close:
+// samples are sorted along a Morton curve, edges by vertex). The answers do not depend on the
+// start (equally close faces go to the lowest-numbered), so the blocks only keep the work the
+// same for any schedule.
 constexpr std::size_t kQueryBlock = 256;
 
 Kernel::Point_3 to_cgal(const Eigen::Vector3d& p) {

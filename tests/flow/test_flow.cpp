@@ -605,7 +605,8 @@ TEST(FlowProjection, NoPointJumpsThroughAThinWall) {
 }
 
 // The walk's point-triangle query (its own, not CGAL's: surface_projection.cpp says why) against
-// CGAL's AABB closest points (distance.h) on a flat, irregular grid, where the Phong lift is
+// DistanceQuery's closest points (CGAL's point-triangle projection over our face tree,
+// distance.h) on a flat, irregular grid, where the Phong lift is
 // zero: query points above and below the interior land in faces, points beyond the border on
 // its edges and at its corners, so every region of the query is exercised.
 TEST(FlowProjection, ClosestPointsAgreeWithCgalOnAFlatGrid) {
@@ -652,7 +653,7 @@ TEST(FlowProjection, VerticesStayOnTheInputSurfaceAndCreasesStayCrisp) {
   free_options.project_to_input = false;
   const FlowResult free = vertex_flow(mesh.V, mesh.F, free_options);
   const double edge = projected.report.mean_edge_length;
-  // Exact distances through the AABB tree (distance.h; checked against brute force there).
+  // Exact distances through DistanceQuery (distance.h; checked against brute force there).
   const DistanceQuery input_surface(mesh.V, mesh.F);
   auto distance_to_input = [&](const Vertices& X) -> Eigen::VectorXd {
     return input_surface.squared_distances(X).cwiseSqrt();
