@@ -36,6 +36,45 @@ void parallel_rows(int rows, Body&& body) {
   parallel_for_index(rows, body, 128, kSerialBelow);
 }
 
+// Fixed chunks of rows for the transposes below: the result does not depend on them, and four
+// keep the per-chunk column counts small (4 ints per column) while two threads share the work.
+constexpr int kTransposeChunks = 4;
+
+// The blocks (r, c) of A with keep(r, c), written transposed into (column, block) at places
+// counted from first[c] for each column c, in order of r: the places of the serial loop over
+// rows. The chunks count their blocks per column, and then each writes its own from its own
+// offsets, in parallel: this transpose on one core was 1.5 s of the hierarchy's set-up at 10M
+// vertices, with the page faults of first writing the result (docs/benchmarks.md).
+template <class Keep>
+void scatter_transposed(const BlockSparseMatrix& A, Keep&& keep, const std::vector<int>& first,
+                        std::vector<int>& column, std::vector<Matrix3>& block) {
+  const int chunk_rows = (A.rows + kTransposeChunks - 1) / kTransposeChunks;
+  std::vector<std::vector<int>> place(kTransposeChunks);
+  auto for_each_kept = [&](int chunk, auto&& visit) {
+    for (int r = chunk * chunk_rows; r < std::min(A.rows, (chunk + 1) * chunk_rows); ++r)
+      for (int m = A.start[static_cast<std::size_t>(r)]; m < A.start[static_cast<std::size_t>(r) + 1]; ++m)
+        if (keep(r, A.column[static_cast<std::size_t>(m)])) visit(r, m);
+  };
+  tbb::parallel_for(0, kTransposeChunks, [&](int chunk) {
+    std::vector<int>& count = place[static_cast<std::size_t>(chunk)];
+    count.assign(static_cast<std::size_t>(A.cols), 0);
+    for_each_kept(chunk, [&](int, int m) { ++count[static_cast<std::size_t>(A.column[static_cast<std::size_t>(m)])]; });
+  });
+  parallel_rows(A.cols, [&](int c) {  // counts -> each chunk's first place in column c
+    int next = first[static_cast<std::size_t>(c)];
+    for (std::vector<int>& count : place) next += std::exchange(count[static_cast<std::size_t>(c)], next);
+  });
+  tbb::parallel_for(0, kTransposeChunks, [&](int chunk) {
+    std::vector<int>& next = place[static_cast<std::size_t>(chunk)];
+    for_each_kept(chunk, [&](int r, int m) {
+      const auto out =
+          static_cast<std::size_t>(next[static_cast<std::size_t>(A.column[static_cast<std::size_t>(m)])]++);
+      column[out] = r;
+      block[out] = A.block[static_cast<std::size_t>(m)].transpose();
+    });
+  });
+}
+
 BlockSparseMatrix transpose(const BlockSparseMatrix& A) {
   BlockSparseMatrix T;
   T.rows = A.cols;
@@ -44,15 +83,9 @@ BlockSparseMatrix transpose(const BlockSparseMatrix& A) {
   for (const int c : A.column) ++T.start[static_cast<std::size_t>(c) + 1];
   std::partial_sum(T.start.begin(), T.start.end(), T.start.begin());
   T.column.resize(A.column.size());
-  T.block.resize(A.block.size());
-  std::vector<int> fill(T.start.begin(), T.start.end() - 1);
-  for (int k = 0; k < A.rows; ++k)  // rows in order, so each row of T is sorted
-    for (int m = A.start[static_cast<std::size_t>(k)]; m < A.start[static_cast<std::size_t>(k) + 1]; ++m) {
-      const auto out =
-          static_cast<std::size_t>(fill[static_cast<std::size_t>(A.column[static_cast<std::size_t>(m)])]++);
-      T.column[out] = k;
-      T.block[out] = A.block[static_cast<std::size_t>(m)].transpose();
-    }
+  T.block.resize(A.block.size());  // not initialised: scatter_transposed writes each block once
+  scatter_transposed(
+      A, [](int, int) { return true; }, T.start, T.column, T.block);
   return T;
 }
 
@@ -115,11 +148,81 @@ Matrix3& BlockRowAccumulator::operator[](int column) {
   return entries_[static_cast<std::size_t>(p)].second;
 }
 
-std::vector<std::pair<int, Matrix3>> BlockRowAccumulator::take() {
+int BlockRowAccumulator::append_to(std::vector<int>& column, std::vector<Matrix3>& block) {
   for (const auto& entry : entries_) position_[static_cast<std::size_t>(entry.first)] = -1;
   std::sort(entries_.begin(), entries_.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
-  return std::exchange(entries_, {});
+  for (const auto& [c, b] : entries_) {
+    column.push_back(c);
+    block.push_back(b);
+  }
+  const auto appended = static_cast<int>(entries_.size());
+  entries_.clear();
+  return appended;
 }
+
+namespace {
+
+// Rows built by one task, compressed: row j of the chunk holds the blocks [start[j], start[j + 1]).
+struct RowChunk {
+  std::vector<int> start;
+  std::vector<int> column;
+  std::vector<Matrix3> block;
+};
+
+// Rows per task of build_row_chunks.
+constexpr int kRowsPerChunk = 64;
+
+// Rows body(0), ..., body(count - 1), built by tasks in fixed chunks of kRowsPerChunk rows into
+// chunks[0, 1, ...]: one allocation per chunk, reused from call to call, instead of one per row.
+// A row per allocation, appended to the matrix and freed by the calling thread, was a fifth of
+// the hierarchy's set-up at 10M vertices, most of it page faults and frees on one core
+// (docs/benchmarks.md).
+void build_row_chunks(int count, const std::function<void(int, BlockRowAccumulator&)>& body,
+                      tbb::enumerable_thread_specific<BlockRowAccumulator>& accumulators,
+                      std::vector<RowChunk>& chunks) {
+  const int num_chunks = (count + kRowsPerChunk - 1) / kRowsPerChunk;
+  if (chunks.size() < static_cast<std::size_t>(num_chunks)) chunks.resize(static_cast<std::size_t>(num_chunks));
+  tbb::parallel_for(0, num_chunks, [&](int c) {
+    RowChunk& chunk = chunks[static_cast<std::size_t>(c)];
+    chunk.start.assign(1, 0);
+    chunk.column.clear();
+    chunk.block.clear();
+    BlockRowAccumulator& accumulator = accumulators.local();
+    for (int k = c * kRowsPerChunk; k < std::min(count, (c + 1) * kRowsPerChunk); ++k) {
+      body(k, accumulator);
+      chunk.start.push_back(chunk.start.back() + accumulator.append_to(chunk.column, chunk.block));
+    }
+  });
+}
+
+// Moves the first `count` rows of `chunks` to the end of the compressed rows (start, column,
+// block), copied into place in parallel so that the first writes of the matrix's pages are
+// shared by the threads; each chunk's storage is freed once copied, so that the rows exist
+// twice for a moment only. `reserve(blocks)` may reserve the arrays first, given the count of
+// new blocks.
+void append_row_chunks(int count, std::vector<RowChunk>& chunks, std::vector<int>& start, std::vector<int>& column,
+                       std::vector<Matrix3>& block, const std::function<void(std::size_t)>& reserve) {
+  const int num_chunks = (count + kRowsPerChunk - 1) / kRowsPerChunk;
+  std::vector<std::size_t> offset(static_cast<std::size_t>(num_chunks) + 1, static_cast<std::size_t>(start.back()));
+  for (int c = 0; c < num_chunks; ++c) {
+    const RowChunk& chunk = chunks[static_cast<std::size_t>(c)];
+    const int base = start.back();
+    for (std::size_t j = 1; j < chunk.start.size(); ++j) start.push_back(base + chunk.start[j]);
+    offset[static_cast<std::size_t>(c) + 1] = offset[static_cast<std::size_t>(c)] + chunk.column.size();
+  }
+  if (reserve) reserve(offset.back() - offset.front());
+  column.resize(offset.back());
+  block.resize(offset.back());  // Eigen's fixed-size matrices are not initialised: no pass
+  tbb::parallel_for(0, num_chunks, [&](int c) {
+    RowChunk& chunk = chunks[static_cast<std::size_t>(c)];
+    const auto at = static_cast<std::ptrdiff_t>(offset[static_cast<std::size_t>(c)]);
+    std::copy(chunk.column.begin(), chunk.column.end(), column.begin() + at);
+    std::copy(chunk.block.begin(), chunk.block.end(), block.begin() + at);
+    chunk = RowChunk();
+  });
+}
+
+}  // namespace
 
 BlockSparseMatrix build_block_rows(int rows, int cols, const std::function<void(int, BlockRowAccumulator&)>& body,
                                    int range_rows, const std::function<void(int, int)>& prepare) {
@@ -130,38 +233,22 @@ BlockSparseMatrix build_block_rows(int rows, int cols, const std::function<void(
   BlockSparseMatrix A;
   A.rows = rows;
   A.cols = cols;
-  A.start.assign(static_cast<std::size_t>(rows) + 1, 0);
+  A.start.reserve(static_cast<std::size_t>(rows) + 1);
   tbb::enumerable_thread_specific<BlockRowAccumulator> accumulators([cols] { return BlockRowAccumulator(cols); });
-  std::vector<std::vector<std::pair<int, Matrix3>>> built;
+  std::vector<RowChunk> chunks;
   for (int r0 = 0; r0 < rows; r0 += range_rows) {
     const int r1 = std::min(rows, r0 + range_rows);
     if (prepare) prepare(r0, r1);
-    built.assign(static_cast<std::size_t>(r1 - r0), {});
-    // Always in parallel: unlike the per-iteration products, a set-up row costs many blocks.
-    tbb::parallel_for(tbb::blocked_range<int>(r0, r1, 16), [&](const tbb::blocked_range<int>& range) {
-      BlockRowAccumulator& accumulator = accumulators.local();
-      for (int k = range.begin(); k != range.end(); ++k) {
-        body(k, accumulator);
-        built[static_cast<std::size_t>(k - r0)] = accumulator.take();
-      }
-    });
-    std::size_t blocks = 0;
-    for (const auto& row : built) blocks += row.size();
-    if (r0 == 0) {
+    auto reserve = [&](std::size_t blocks) {
+      if (r0 > 0) return;
       const double per_row = static_cast<double>(blocks) / (r1 - r0);
       const auto expected = static_cast<std::size_t>(1.05 * per_row * rows) + blocks;
       A.column.reserve(expected);
       A.block.reserve(expected);
-    }
-    for (int k = r0; k < r1; ++k) {
-      auto& row = built[static_cast<std::size_t>(k - r0)];
-      A.start[static_cast<std::size_t>(k) + 1] = A.start[static_cast<std::size_t>(k)] + static_cast<int>(row.size());
-      for (const auto& [column, block] : row) {
-        A.column.push_back(column);
-        A.block.push_back(block);
-      }
-      std::vector<std::pair<int, Matrix3>>().swap(row);
-    }
+    };
+    build_row_chunks(
+        r1 - r0, [&](int k, BlockRowAccumulator& row) { body(r0 + k, row); }, accumulators, chunks);
+    append_row_chunks(r1 - r0, chunks, A.start, A.column, A.block, reserve);
   }
   return A;
 }
@@ -185,21 +272,9 @@ BlockSparseMatrix symmetric_from_upper(const BlockSparseMatrix& upper) {
     S.start[k + 1] = S.start[k] + lower_count[k] + (upper.start[k + 1] - upper.start[k]);
   S.column.resize(static_cast<std::size_t>(S.start.back()));
   S.block.resize(static_cast<std::size_t>(S.start.back()));
-  // The blocks' pages first touched by all threads: touched by the serial transpose below,
-  // their faults took 2.7 s of the 10M-vertex run's main thread (a 1.8 GB matrix).
-  parallel_rows(S.rows, [&](int k) {
-    for (int m = S.start[static_cast<std::size_t>(k)]; m < S.start[static_cast<std::size_t>(k) + 1]; ++m)
-      S.block[static_cast<std::size_t>(m)].setZero();
-  });
-  std::vector<int> fill(S.start.begin(), S.start.end() - 1);
-  for (std::size_t r = 0; r < rows; ++r)  // rows in order, so each lower part is sorted
-    for (int m = upper.start[r]; m < upper.start[r + 1]; ++m) {
-      const int c = upper.column[static_cast<std::size_t>(m)];
-      if (c == static_cast<int>(r)) continue;
-      const auto out = static_cast<std::size_t>(fill[static_cast<std::size_t>(c)]++);
-      S.column[out] = static_cast<int>(r);
-      S.block[out] = upper.block[static_cast<std::size_t>(m)].transpose();
-    }
+  // Row k's lower part first, from upper's blocks (r, k), r < k, in order of r.
+  scatter_transposed(
+      upper, [](int r, int c) { return c != r; }, S.start, S.column, S.block);
   parallel_rows(upper.rows, [&](int k) {
     const auto row = static_cast<std::size_t>(k);
     auto out = static_cast<std::size_t>(S.start[row] + lower_count[row]);
@@ -279,9 +354,9 @@ namespace {
 // set-up. Each row of A P and each block of the product is summed in the order of the whole
 // product, so the result is the same.
 BlockSparseMatrix galerkin_product(const BlockSparseMatrix& A, const BlockSparseMatrix& P, const BlockSparseMatrix& R) {
-  std::vector<int> slot(static_cast<std::size_t>(A.rows), -1);  // row of A P -> its place in `ap`
+  std::vector<int> slot(static_cast<std::size_t>(A.rows), -1);  // row of A P -> its row in `ap`
   std::vector<int> needed;
-  std::vector<std::vector<std::pair<int, Matrix3>>> ap;
+  std::vector<RowChunk> ap;  // the rows `needed` of A P, kRowsPerChunk to a chunk
   tbb::enumerable_thread_specific<BlockRowAccumulator> accumulators([&] { return BlockRowAccumulator(P.cols); });
   // Before each range of coarse rows: the rows of A P it reads, in place of the last range's.
   auto prepare = [&](int i0, int i1) {
@@ -294,30 +369,30 @@ BlockSparseMatrix galerkin_product(const BlockSparseMatrix& A, const BlockSparse
         needed.push_back(k);
       }
     }
-    ap.assign(needed.size(), {});
-    tbb::parallel_for(
-        tbb::blocked_range<std::size_t>(0, needed.size(), 64), [&](const tbb::blocked_range<std::size_t>& r) {
-          BlockRowAccumulator& row = accumulators.local();
-          for (std::size_t t = r.begin(); t != r.end(); ++t) {
-            const auto k = static_cast<std::size_t>(needed[t]);
-            for (int m = A.start[k]; m < A.start[k + 1]; ++m) {
-              const int l = A.column[static_cast<std::size_t>(m)];
-              const Matrix3& a = A.block[static_cast<std::size_t>(m)];
-              for (int q = P.start[static_cast<std::size_t>(l)]; q < P.start[static_cast<std::size_t>(l) + 1]; ++q)
-                row[P.column[static_cast<std::size_t>(q)]].noalias() += a * P.block[static_cast<std::size_t>(q)];
-            }
-            ap[t] = row.take();
+    build_row_chunks(
+        static_cast<int>(needed.size()),
+        [&](int t, BlockRowAccumulator& row) {
+          const auto k = static_cast<std::size_t>(needed[static_cast<std::size_t>(t)]);
+          for (int m = A.start[k]; m < A.start[k + 1]; ++m) {
+            const int l = A.column[static_cast<std::size_t>(m)];
+            const Matrix3& a = A.block[static_cast<std::size_t>(m)];
+            for (int q = P.start[static_cast<std::size_t>(l)]; q < P.start[static_cast<std::size_t>(l) + 1]; ++q)
+              row[P.column[static_cast<std::size_t>(q)]].noalias() += a * P.block[static_cast<std::size_t>(q)];
           }
-        });
+        },
+        accumulators, ap);
   };
   return build_block_rows(
       R.rows, P.cols,
       [&](int i, BlockRowAccumulator& row) {
         for (int m = R.start[static_cast<std::size_t>(i)]; m < R.start[static_cast<std::size_t>(i) + 1]; ++m) {
           const Matrix3& left = R.block[static_cast<std::size_t>(m)];
-          for (const auto& [column, block] :
-               ap[static_cast<std::size_t>(slot[static_cast<std::size_t>(R.column[static_cast<std::size_t>(m)])])])
-            row[column].noalias() += left * block;
+          const auto t =
+              static_cast<std::size_t>(slot[static_cast<std::size_t>(R.column[static_cast<std::size_t>(m)])]);
+          const RowChunk& chunk = ap[t / kRowsPerChunk];
+          const std::size_t j = t % kRowsPerChunk;
+          for (int q = chunk.start[j]; q < chunk.start[j + 1]; ++q)
+            row[chunk.column[static_cast<std::size_t>(q)]].noalias() += left * chunk.block[static_cast<std::size_t>(q)];
         }
       },
       8192, prepare);

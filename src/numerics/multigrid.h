@@ -40,8 +40,9 @@ class BlockRowAccumulator {
  public:
   explicit BlockRowAccumulator(int cols);
   Eigen::Matrix3d& operator[](int column);
-  /// Moves the row out, sorted by column, and clears the accumulator.
-  std::vector<std::pair<int, Eigen::Matrix3d>> take();
+  /// Appends the row's blocks, sorted by column, to `column` and `block`, clears the
+  /// accumulator (keeping its storage for the next row) and returns how many it appended.
+  int append_to(std::vector<int>& column, std::vector<Eigen::Matrix3d>& block);
 
  private:
   std::vector<int> position_;
