@@ -11,6 +11,7 @@
 #include <iterator>
 #include <limits>
 #include <stdexcept>
+#include <utility>
 
 namespace vertexflow {
 namespace {
@@ -54,22 +55,74 @@ std::vector<char> bad_faces(const GuardCriteria& criteria, const Vertices& X) {
   return bad;
 }
 
+// The halving state of the vertices that shorten_until_good moved: their displacement from the
+// anchor at the call's start, step and halvings. Untouched vertices have step 1 and are where
+// the call found them. The guard keeps one across its calls and resets the vertices each call
+// touched: buffers of the mesh's size filled afresh by every call (and the copy X - anchor) made
+// each call O(n), and at 10M vertices their first writes, on one core, were a third of the
+// guard (docs/benchmarks.md).
+class HalvingState {
+ public:
+  explicit HalvingState(std::size_t n) : slot_(n, -1), chosen_(n, 0) {}
+
+  // Vertex i's displacement from `anchor` when the call started (X is unchanged where untouched).
+  [[nodiscard]] Eigen::Vector3d displacement(Index i, const Vertices& X, const Vertices& anchor) const {
+    const int s = slot_[static_cast<std::size_t>(i)];
+    return s >= 0 ? touched_[static_cast<std::size_t>(s)].displacement : Eigen::Vector3d(X.row(i) - anchor.row(i));
+  }
+  [[nodiscard]] double step(Index i) const {
+    const int s = slot_[static_cast<std::size_t>(i)];
+    return s >= 0 ? touched_[static_cast<std::size_t>(s)].step : 1.0;
+  }
+  // Halves vertex i's step (0 at its max_halvings-th halving) and returns the new step and
+  // displacement.
+  std::pair<double, Eigen::Vector3d> halve(Index i, const Vertices& X, const Vertices& anchor, int max_halvings) {
+    int& s = slot_[static_cast<std::size_t>(i)];
+    if (s < 0) {
+      s = static_cast<int>(touched_.size());
+      touched_.push_back({i, Eigen::Vector3d(X.row(i) - anchor.row(i)), 1.0, 0});
+    }
+    Touched& t = touched_[static_cast<std::size_t>(s)];
+    t.step = ++t.halvings >= max_halvings ? 0.0 : 0.5 * t.step;
+    return {t.step, t.displacement};
+  }
+  // Per round: whether a vertex is already chosen.
+  std::vector<char>& chosen() { return chosen_; }
+  // Forgets every vertex touched since the last reset.
+  void reset() {
+    for (const Touched& t : touched_) slot_[static_cast<std::size_t>(t.vertex)] = -1;
+    touched_.clear();
+  }
+
+ private:
+  struct Touched {
+    Index vertex;
+    Eigen::Vector3d displacement;
+    double step;
+    int halvings;
+  };
+  std::vector<int> slot_;  // index in touched_, or -1
+  std::vector<Touched> touched_;
+  std::vector<char> chosen_;
+};
+
 // The free corner of bad face f whose halving helps f most (ties: the first corner), or -1 if
 // every corner is fixed or already back at its anchor. Shortening only that corner, and not all
 // three, keeps the moves of corners that did not cause the damage: a sliver flips when one of
 // its corners crosses the opposite edge, and halving the other two as well shortened 21% of
 // fandisk's vertices for its 29 low-quality faces (now 0.4%).
 Index corner_to_shorten(const GuardCriteria& criteria, Index f, const Vertices& X, const Vertices& anchor,
-                        const Vertices& displacement, const std::vector<double>& step, const std::vector<char>& fixed) {
+                        const HalvingState& state, const std::vector<char>& fixed) {
   const Faces& F = criteria.F;
   Index best = -1;
   double best_score = -std::numeric_limits<double>::infinity();
   for (int k = 0; k < 3; ++k) {
     const Index i = F(f, k);
     const auto v = static_cast<std::size_t>(i);
-    if (fixed[v] || step[v] == 0.0) continue;
+    const double step = state.step(i);
+    if (fixed[v] || step == 0.0) continue;
     Eigen::Vector3d corner[3] = {X.row(F(f, 0)), X.row(F(f, 1)), X.row(F(f, 2))};
-    corner[k] = anchor.row(i) + 0.5 * step[v] * displacement.row(i);
+    corner[k] = anchor.row(i).transpose() + 0.5 * step * state.displacement(i, X, anchor);
     const double score = face_score(criteria, f, corner[0], corner[1], corner[2]);
     if (best < 0 || score > best_score) {
       best = i;
@@ -108,16 +161,12 @@ std::vector<Index> bad_among(const std::vector<Index>& faces, const GuardCriteri
 // `shortened` the vertices it halved.
 void shorten_until_good(Vertices& X, const Vertices& anchor, const GuardCriteria& criteria, std::vector<Index> bad_list,
                         const std::vector<char>& fixed, const Topology& topology, const GuardOptions& options,
-                        const Reprojection& reproject, std::vector<char>& shortened) {
-  const auto n = static_cast<std::size_t>(X.rows());
-  const Vertices displacement = X - anchor;
-  std::vector<double> step(n, 1.0);
-  std::vector<int> halvings(n, 0);
-  std::vector<char> chosen(n, 0);
+                        const Reprojection& reproject, std::vector<char>& shortened, HalvingState& state) {
+  std::vector<char>& chosen = state.chosen();
   while (!bad_list.empty()) {
     std::vector<Index> moved, to_reproject;
     for (const Index f : bad_list) {
-      const Index i = corner_to_shorten(criteria, f, X, anchor, displacement, step, fixed);
+      const Index i = corner_to_shorten(criteria, f, X, anchor, state, fixed);
       if (i < 0 || chosen[static_cast<std::size_t>(i)]) continue;
       chosen[static_cast<std::size_t>(i)] = 1;
       moved.push_back(i);
@@ -127,11 +176,11 @@ void shorten_until_good(Vertices& X, const Vertices& anchor, const GuardCriteria
     for (const Index i : moved) {
       const auto v = static_cast<std::size_t>(i);
       chosen[v] = 0;
-      step[v] = ++halvings[v] >= options.max_halvings ? 0.0 : 0.5 * step[v];
+      const auto [step, displacement] = state.halve(i, X, anchor, options.max_halvings);
       shortened[v] = 1;
-      X.row(i) = anchor.row(i) + step[v] * displacement.row(i);
+      X.row(i) = anchor.row(i) + step * displacement.transpose();
       // Back onto the surface, except at step 0: the anchor itself, exactly.
-      if (step[v] != 0.0 && reproject) to_reproject.push_back(i);
+      if (step != 0.0 && reproject) to_reproject.push_back(i);
     }
     if (reproject) reproject(X, to_reproject);
     // Only the faces around the moved vertices can have changed; the other bad faces stay bad.
@@ -142,6 +191,7 @@ void shorten_until_good(Vertices& X, const Vertices& anchor, const GuardCriteria
     bad_list.clear();
     std::set_union(unchanged.begin(), unchanged.end(), now_bad.begin(), now_bad.end(), std::back_inserter(bad_list));
   }
+  state.reset();
 }
 
 }  // namespace
@@ -183,22 +233,27 @@ GuardCounts guard(Vertices& X, const Vertices& anchor, const GuardCriteria& crit
     if (bad[static_cast<std::size_t>(f)]) bad_list.push_back(f);
   }
   std::vector<char> short_of_target(n, 0);
-  shorten_until_good(X, anchor, criteria, std::move(bad_list), fixed, topology, options, reproject, short_of_target);
+  HalvingState state(n);
+  shorten_until_good(X, anchor, criteria, std::move(bad_list), fixed, topology, options, reproject, short_of_target,
+                     state);
   // Further passes offer every vertex left short of its target its whole move again, from where
   // it is now: once its neighbours have moved, a move that flipped a sliver often no longer
-  // does. Each pass starts and ends with no bad face (kPassGainStop says when they stop).
+  // does. Each pass starts and ends with no bad face (kPassGainStop says when they stop). Their
+  // buffers are allocated once.
+  Vertices retry;
+  std::vector<char> shortened_again(n);
   for (int pass = 0; pass < kGuardPasses; ++pass) {
-    Vertices retry = X;
+    retry = X;
     std::vector<Index> retried;
     for (std::size_t v = 0; v < n; ++v) {
       if (!short_of_target[v]) continue;
       retry.row(static_cast<Index>(v)) = target.row(static_cast<Index>(v));
       retried.push_back(static_cast<Index>(v));
     }
-    std::vector<char> shortened_again(n, 0);
+    std::fill(shortened_again.begin(), shortened_again.end(), 0);
     // X has no bad face: only faces around the retried vertices can be bad in `retry`.
     shorten_until_good(retry, X, criteria, bad_among(faces_around(retried, topology), criteria, retry), fixed, topology,
-                       options, reproject, shortened_again);
+                       options, reproject, shortened_again, state);
     std::size_t reached = 0;
     for (const Index i : retried) {
       const auto v = static_cast<std::size_t>(i);
@@ -207,7 +262,7 @@ GuardCounts guard(Vertices& X, const Vertices& anchor, const GuardCriteria& crit
         ++reached;
       }
     }
-    X = std::move(retry);
+    X.swap(retry);
     if (reached * kPassGainStop < retried.size()) break;
   }
   for (std::size_t v = 0; v < n; ++v) shortened[v] = shortened[v] || short_of_target[v];
