@@ -195,13 +195,12 @@ void build_row_chunks(int count, const std::function<void(int, BlockRowAccumulat
   });
 }
 
-// Moves the first `count` rows of `chunks` to the end of the compressed rows (start, column,
-// block), copied into place in parallel so that the first writes of the matrix's pages are
-// shared by the threads; each chunk's storage is freed once copied, so that the rows exist
-// twice for a moment only. `reserve(blocks)` may reserve the arrays first, given the count of
-// new blocks.
-void append_row_chunks(int count, std::vector<RowChunk>& chunks, std::vector<int>& start, std::vector<int>& column,
-                       std::vector<Matrix3>& block, const std::function<void(std::size_t)>& reserve) {
+// Appends the first `count` rows of `chunks` to the compressed rows (start, column, block),
+// copied into place in parallel so that the first writes of the matrix's pages are shared by
+// the threads. `reserve(blocks)` may reserve the arrays first, given the count of new blocks.
+void append_row_chunks(int count, const std::vector<RowChunk>& chunks, std::vector<int>& start,
+                       std::vector<int>& column, std::vector<Matrix3>& block,
+                       const std::function<void(std::size_t)>& reserve) {
   const int num_chunks = (count + kRowsPerChunk - 1) / kRowsPerChunk;
   std::vector<std::size_t> offset(static_cast<std::size_t>(num_chunks) + 1, static_cast<std::size_t>(start.back()));
   for (int c = 0; c < num_chunks; ++c) {
@@ -214,11 +213,10 @@ void append_row_chunks(int count, std::vector<RowChunk>& chunks, std::vector<int
   column.resize(offset.back());
   block.resize(offset.back());  // Eigen's fixed-size matrices are not initialised: no pass
   tbb::parallel_for(0, num_chunks, [&](int c) {
-    RowChunk& chunk = chunks[static_cast<std::size_t>(c)];
+    const RowChunk& chunk = chunks[static_cast<std::size_t>(c)];
     const auto at = static_cast<std::ptrdiff_t>(offset[static_cast<std::size_t>(c)]);
     std::copy(chunk.column.begin(), chunk.column.end(), column.begin() + at);
     std::copy(chunk.block.begin(), chunk.block.end(), block.begin() + at);
-    chunk = RowChunk();
   });
 }
 
