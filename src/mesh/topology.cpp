@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <atomic>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <stdexcept>
 #include <string>
@@ -211,13 +212,14 @@ Topology build_topology(const Faces& F, Index num_vertices) {
   };
   // Each vertex's list is computed once into a scratch area sized by its corner count (a
   // vertex with d incident faces has at most 2d neighbours), then compacted.
+  // The scratch area is not initialised (a vector would zero it on one core first: half a GB at
+  // 10M vertices); each vertex writes its part before it is read.
   std::vector<Index> edge_counts(static_cast<std::size_t>(nv));
-  std::vector<Index> scratch_neighbours(2 * t.vertex_faces.size());
+  auto scratch_neighbours = std::make_unique_for_overwrite<Index[]>(2 * t.vertex_faces.size());
   parallel_vertices(nv, [&](Index v, std::vector<Index>& scratch) {
     larger_neighbours(v, scratch);
-    std::copy(
-        scratch.begin(), scratch.end(),
-        scratch_neighbours.begin() + 2 * static_cast<std::ptrdiff_t>(t.face_offsets[static_cast<std::size_t>(v)]));
+    std::copy(scratch.begin(), scratch.end(),
+              scratch_neighbours.get() + 2 * static_cast<std::ptrdiff_t>(t.face_offsets[static_cast<std::size_t>(v)]));
     edge_counts[static_cast<std::size_t>(v)] = static_cast<Index>(scratch.size());
   });
   const std::vector<Index> edge_offsets = offsets_from_counts(edge_counts);
@@ -225,12 +227,12 @@ Topology build_topology(const Faces& F, Index num_vertices) {
   t.edges.resize(ne, 2);
   parallel_vertices(nv, [&](Index v, std::vector<Index>&) {
     const Index* source =
-        scratch_neighbours.data() + 2 * static_cast<std::size_t>(t.face_offsets[static_cast<std::size_t>(v)]);
+        scratch_neighbours.get() + 2 * static_cast<std::size_t>(t.face_offsets[static_cast<std::size_t>(v)]);
     Index e = edge_offsets[static_cast<std::size_t>(v)];
     for (Index i = 0; i < edge_counts[static_cast<std::size_t>(v)]; ++i, ++e)
       t.edges(e, 0) = v, t.edges(e, 1) = source[i];
   });
-  scratch_neighbours = std::vector<Index>();
+  scratch_neighbours.reset();
   // A vertex's edges are sorted by their other end: binary search, since one vertex can own
   // O(n) edges (a triangulated comb's spine, a fan), and a scan made the face loop quadratic.
   auto find_edge = [&](Index a, Index b) {
@@ -253,15 +255,23 @@ Topology build_topology(const Faces& F, Index num_vertices) {
       for (int k = 0; k < 3; ++k) t.face_edges(f, k) = find_edge(F(f, k), F(f, (k + 1) % 3));
     }
   });
+  // Each edge's face count and first two faces in face order, filled by the edge's owner (its
+  // smaller vertex) from its incident faces, which are in face order here: the faces of the
+  // serial loop over faces, on all threads, and no one else writes the owner's edges.
   t.edge_face_count.assign(static_cast<std::size_t>(ne), 0);
-  std::vector<Index> edge_face(2 * static_cast<std::size_t>(ne), -1);
-  for (Index f = 0; f < nf; ++f) {
-    for (int k = 0; k < 3; ++k) {
-      const auto e = static_cast<std::size_t>(t.face_edges(f, k));
-      const Index seen = t.edge_face_count[e]++;
-      if (seen < 2) edge_face[2 * e + static_cast<std::size_t>(seen)] = f;
-    }
-  }
+  auto edge_face = std::make_unique_for_overwrite<Index[]>(2 * static_cast<std::size_t>(ne));
+  parallel_vertices(nv, [&](Index a, std::vector<Index>&) {
+    for (Index e = edge_offsets[static_cast<std::size_t>(a)]; e < edge_offsets[static_cast<std::size_t>(a) + 1]; ++e)
+      edge_face[2 * static_cast<std::size_t>(e)] = edge_face[2 * static_cast<std::size_t>(e) + 1] = -1;
+    const auto [begin, end] = incident_faces(a);
+    for (const Index* f = begin; f != end; ++f)
+      for (int k = 0; k < 3; ++k) {
+        if (F(*f, k) <= a) continue;
+        const auto e = static_cast<std::size_t>(find_edge(a, F(*f, k)));
+        const Index seen = t.edge_face_count[e]++;
+        if (seen < 2) edge_face[2 * e + static_cast<std::size_t>(seen)] = *f;
+      }
+  });
   t.face_adjacency.resize(nf, 3);
   std::atomic<bool> oriented{true};
   tbb::parallel_for(tbb::blocked_range<Index>(0, nf, 8192), [&](const tbb::blocked_range<Index>& r) {
