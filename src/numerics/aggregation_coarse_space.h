@@ -25,28 +25,19 @@ namespace vertexflow {
 
 class AggregationCoarseSpace {
  public:
-  /// phi_a(i) of aggregate a at vertex i. Packed to 12 bytes (the value 4-byte aligned, which
-  /// x86-64 and AArch64 load at full speed): the weights are read twice per iteration (Phi^T r
-  /// and Phi x), a pass bound by their bytes, and held through the solve, the flow's peak.
-#pragma pack(push, 4)
+  /// phi_a(i) of aggregate a at vertex i.
   struct Weight {
     Index aggregate;  ///< (in member lists: the vertex)
     double value;
   };
-#pragma pack(pop)
-  static_assert(sizeof(Weight) == 12);
 
   /// The graph (CSR: vertex i's neighbours are neighbours[start[i] .. start[i + 1])), and the
   /// vertices held fixed (no unknowns, in no aggregate, phi = 0 there).
   AggregationCoarseSpace(const std::vector<Index>& start, const std::vector<Index>& neighbours,
                          const std::vector<char>& fixed);
 
-  [[nodiscard]] int size() const {
-    return count_;
-  }
-  [[nodiscard]] Index num_vertices() const {
-    return n_;
-  }
+  [[nodiscard]] int size() const { return count_; }
+  [[nodiscard]] Index num_vertices() const { return n_; }
   /// The basis functions non-zero at vertex i, sorted by aggregate: phi_a = (I - omega (I - W))
   /// chi_a on free vertices, W the one-ring average, chi_a the indicator of aggregate a.
   [[nodiscard]] std::span<const Weight> basis(Index i) const {
