@@ -59,8 +59,7 @@ std::vector<char> bad_faces(const GuardCriteria& criteria, const Vertices& X) {
 // anchor at the call's start, step and halvings. Untouched vertices have step 1 and are where
 // the call found them. The guard keeps one across its calls and resets the vertices each call
 // touched: buffers of the mesh's size filled afresh by every call (and the copy X - anchor) made
-// each call O(n), and at 10M vertices their first writes, on one core, were a third of the
-// guard (docs/benchmarks.md).
+// each call O(n), about 1 s of the 10M-vertex guard's 5-8 s on one core (docs/benchmarks.md).
 class HalvingState {
  public:
   explicit HalvingState(std::size_t n) : slot_(n, -1), chosen_(n, 0) {}

@@ -174,9 +174,9 @@ constexpr int kRowsPerChunk = 64;
 
 // Rows body(0), ..., body(count - 1), built by tasks in fixed chunks of kRowsPerChunk rows into
 // chunks[0, 1, ...]: one allocation per chunk, reused from call to call, instead of one per row.
-// A row per allocation, appended to the matrix and freed by the calling thread, was a fifth of
-// the hierarchy's set-up at 10M vertices, most of it page faults and frees on one core
-// (docs/benchmarks.md).
+// A row per allocation, appended to the matrix and freed by the calling thread, cost about 7 s
+// of the hierarchy set-up's 41 s of main-thread samples at 10M vertices, page faults, frees
+// and the append on one core (docs/benchmarks.md).
 void build_row_chunks(int count, const std::function<void(int, BlockRowAccumulator&)>& body,
                       tbb::enumerable_thread_specific<BlockRowAccumulator>& accumulators,
                       std::vector<RowChunk>& chunks) {
