@@ -1,5 +1,6 @@
 // build_topology on the ~1M-vertex test mesh (bench_support.h), with TBB allowed all cores
-// and limited to one thread, and on the 43k-vertex armadillo it is made from.
+// and limited to one thread, on the 43k-vertex armadillo it is made from, and on bunny_uniform
+// (8.9k vertices; bench_flow's smallest bar).
 //
 //   build/bin/bench_topology --benchmark_repetitions=5 --benchmark_report_aggregates_only=true
 #include "bench_support.h"
@@ -25,6 +26,11 @@ const Mesh& large_mesh() {
   return mesh;
 }
 
+const Mesh& bunny() {
+  static const Mesh mesh = read_mesh(data_dir() / "bunny_uniform.off");
+  return mesh;
+}
+
 const Mesh& armadillo() {
   static const Mesh mesh = read_mesh(data_dir() / "armadillo-43k.obj");
   return mesh;
@@ -47,11 +53,29 @@ void run(benchmark::State& state, const Mesh& mesh) {
   state.SetItemsProcessed(state.iterations() * mesh.num_faces());  // faces per second
 }
 
-void BM_BuildTopology_1M(benchmark::State& state) { run(state, large_mesh()); }
-void BM_BuildTopology_Armadillo43k(benchmark::State& state) { run(state, armadillo()); }
+void BM_BuildTopology_1M(benchmark::State& state) {
+  run(state, large_mesh());
+}
+void BM_BuildTopology_Armadillo43k(benchmark::State& state) {
+  run(state, armadillo());
+}
+void BM_BuildTopology_BunnyUniform(benchmark::State& state) {
+  run(state, bunny());
+}
 
 BENCHMARK(BM_BuildTopology_1M)->ArgName("tbb_threads")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
-BENCHMARK(BM_BuildTopology_Armadillo43k)->ArgName("tbb_threads")->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
+BENCHMARK(BM_BuildTopology_Armadillo43k)
+    ->ArgName("tbb_threads")
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
+BENCHMARK(BM_BuildTopology_BunnyUniform)
+    ->ArgName("tbb_threads")
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime();
 
 }  // namespace
 }  // namespace vertexflow::bench

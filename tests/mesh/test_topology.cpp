@@ -239,6 +239,72 @@ TEST(Topology, InvariantUnderVertexAndFaceReordering) {
     ASSERT_EQ(t.valence(perm[static_cast<std::size_t>(v)]), reference.valence(v));
 }
 
+// A fan of `n` faces about vertex 0 over the rim 1, 2, ..., (closed: the rim's last vertex joins
+// its first), the faces in a shuffled order, optionally with the first rim face reversed. Up to
+// 32 faces a fan is ordered by a scan, above it by sorting (topology.cpp); both must give the
+// ring and face order that the rule of topology.h and order_one_ring gives: a closed fan starts
+// at the lowest-numbered face's next corner; an open one at the end that is a face's next
+// corner, else (orientation inconsistent) at the end in the lowest-numbered face.
+TEST(Topology, FansOfEverySizeAreOrderedByTheSameRule) {
+  std::mt19937 rng(7);
+  for (const Index n : {3, 5, 8, 16, 31, 32, 33, 40, 64}) {
+    for (const bool closed : {true, false}) {
+      for (const bool flip_first : {false, true}) {
+        if (closed && flip_first) continue;  // an inconsistent closed fan is still a fan; covered below
+        const Index rim = closed ? n : n + 1;
+        std::vector<std::array<Index, 3>> list;  // rim face i: (0, 1 + i, 1 + (i + 1) % rim)
+        for (Index i = 0; i < n; ++i) list.push_back({0, 1 + i, 1 + (i + 1) % rim});
+        if (flip_first) std::swap(list[0][1], list[0][2]);
+        std::vector<Index> order(static_cast<std::size_t>(n));  // order[k]: the rim face at row k
+        std::iota(order.begin(), order.end(), 0);
+        std::shuffle(order.begin(), order.end(), rng);
+        Faces F(n, 3);
+        std::vector<Index> row_of(static_cast<std::size_t>(n));
+        for (Index k = 0; k < n; ++k) {
+          const auto& f = list[static_cast<std::size_t>(order[static_cast<std::size_t>(k)])];
+          F.row(k) << f[0], f[1], f[2];
+          row_of[static_cast<std::size_t>(order[static_cast<std::size_t>(k)])] = k;
+        }
+        const Topology t = build_topology(F, 1 + rim);
+        SCOPED_TRACE(::testing::Message()
+                     << n << " faces, " << (closed ? "closed" : "open") << (flip_first ? ", first reversed" : ""));
+        if (!flip_first) check_invariants(F, t);  // its boundary loops assume one orientation
+        ASSERT_TRUE(t.is_manifold_vertex[0]);
+        // The expected walk along the rim: forwards from the start, or backwards.
+        Index start = 0;  // rim position of the ring's first vertex
+        bool forwards = true;
+        if (closed) {
+          start = order[0];  // row 0's face is rim face order[0], whose next corner is rim vertex order[0]
+        } else if (flip_first && row_of[0] < row_of[static_cast<std::size_t>(n - 1)]) {
+          // No end is a face's next corner; the lowest-numbered end face is rim face 0, whose
+          // previous corner is rim vertex 0.
+        } else if (flip_first) {
+          start = n, forwards = false;  // the end face n - 1 comes first; its previous corner is rim vertex n
+        }
+        std::vector<Index> expected_ring, expected_faces;
+        for (Index s = 0; s < (closed ? n : n + 1); ++s)
+          expected_ring.push_back(1 + (forwards ? (start + s) % rim : start - s));
+        for (Index s = 0; s < n; ++s) {
+          const Index face = closed ? (start + s) % n : forwards ? s : n - 1 - s;
+          expected_faces.push_back(row_of[static_cast<std::size_t>(face)]);
+        }
+        EXPECT_EQ(ring_of(t, 0), expected_ring);
+        EXPECT_EQ(std::vector<Index>(t.vertex_faces.begin(), t.vertex_faces.begin() + n), expected_faces);
+      }
+    }
+    // Two closed fans of n faces each joined at vertex 0 (a bowtie): not one fan, at any size.
+    Faces bowtie(2 * n, 3);
+    for (Index i = 0; i < n; ++i) {
+      bowtie.row(i) << 0, 1 + i, 1 + (i + 1) % n;
+      bowtie.row(n + i) << 0, 1 + n + i, 1 + n + (i + 1) % n;
+    }
+    const Topology t = build_topology(bowtie, 1 + 2 * n);
+    EXPECT_FALSE(t.is_manifold_vertex[0]) << n;
+    const std::vector<Index> ring = ring_of(t, 0);
+    EXPECT_TRUE(std::is_sorted(ring.begin(), ring.end())) << n;
+  }
+}
+
 TEST(Topology, RejectsFacesThatRepeatAVertex) {
   // Such a face has no third edge; read_mesh removes them, library callers get an error.
   EXPECT_THROW(build_topology(faces({{0, 1, 2}, {0, 0, 3}}), 4), std::invalid_argument);
