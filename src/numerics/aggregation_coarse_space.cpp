@@ -3,6 +3,7 @@
 #include "numerics/parallel.h"
 
 #include <algorithm>
+#include <utility>
 
 namespace vertexflow {
 namespace {
@@ -21,15 +22,16 @@ AggregationCoarseSpace::AggregationCoarseSpace(const std::vector<Index>& start, 
     : n_(static_cast<Index>(fixed.size())) {
   const std::vector<int> aggregate = aggregate_nodes(start, neighbours, fixed, count_);
   const auto n = static_cast<std::size_t>(n_);
-  basis_start_.assign(n + 1, 0);
-  for (std::size_t i = 0; i < n; ++i)
-    basis_start_[i + 1] = basis_start_[i] + 1 + static_cast<std::size_t>(start[i + 1] - start[i]);
-  basis_.resize(basis_start_[n]);
+  // Each vertex gets room for its whole one-ring first, about twice what its basis functions
+  // take; they are then packed into the two arrays kept through the set-up and the solve.
+  std::vector<std::size_t> room(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) room[i + 1] = room[i] + 1 + static_cast<std::size_t>(start[i + 1] - start[i]);
+  std::vector<Weight> weights(room[n]);
   std::vector<std::size_t> basis_size(n, 0);
   parallel_for_index(n_, [&](Index i) {
     const auto v = static_cast<std::size_t>(i);
     if (fixed[v]) return;
-    Weight* out = basis_.data() + basis_start_[v];
+    Weight* out = weights.data() + room[v];
     std::size_t size = 0;
     auto add = [&](Index a, double value) {
       for (std::size_t k = 0; k < size; ++k)
@@ -49,29 +51,31 @@ AggregationCoarseSpace::AggregationCoarseSpace(const std::vector<Index>& start, 
     std::sort(out, out + size, [](const Weight& x, const Weight& y) { return x.aggregate < y.aggregate; });
     basis_size[v] = size;
   });
-  // Packed: each vertex was given room for its whole one-ring, about twice what its basis
-  // functions take (kept through the set-up and the solve).
-  std::size_t packed = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    if (packed != basis_start_[i])  // packed < start: a forward copy is safe
-      std::copy_n(basis_.begin() + static_cast<std::ptrdiff_t>(basis_start_[i]), basis_size[i],
-                  basis_.begin() + static_cast<std::ptrdiff_t>(packed));
-    basis_start_[i] = packed;
-    packed += basis_size[i];
-  }
-  basis_start_[n] = packed;
-  basis_.resize(packed);
-  basis_.shrink_to_fit();
+  basis_start_.assign(n + 1, 0);
+  for (std::size_t i = 0; i < n; ++i) basis_start_[i + 1] = basis_start_[i] + basis_size[i];
+  basis_aggregate_.resize(basis_start_[n]);
+  basis_value_.resize(basis_start_[n]);
+  parallel_for_index(n_, [&](Index i) {
+    const auto v = static_cast<std::size_t>(i);
+    for (std::size_t k = 0; k < basis_size[v]; ++k) {
+      basis_aggregate_[basis_start_[v] + k] = weights[room[v] + k].aggregate;
+      basis_value_[basis_start_[v] + k] = weights[room[v] + k].value;
+    }
+  });
+  std::vector<Weight>().swap(weights);
   const auto na = static_cast<std::size_t>(count_);
   member_start_.assign(na + 1, 0);
-  for (std::size_t i = 0; i < n; ++i)
-    for (const Weight& w : basis(static_cast<Index>(i))) ++member_start_[static_cast<std::size_t>(w.aggregate) + 1];
+  for (const Index a : basis_aggregate_) ++member_start_[static_cast<std::size_t>(a) + 1];
   for (std::size_t a = 0; a < na; ++a) member_start_[a + 1] += member_start_[a];
-  members_.resize(member_start_[na]);
+  member_vertex_.resize(member_start_[na]);
+  member_value_.resize(member_start_[na]);
   std::vector<std::size_t> fill(member_start_.begin(), member_start_.end() - 1);
   for (std::size_t i = 0; i < n; ++i)
-    for (const Weight& w : basis(static_cast<Index>(i)))
-      members_[fill[static_cast<std::size_t>(w.aggregate)]++] = {static_cast<Index>(i), w.value};
+    for (const Weight& w : basis(static_cast<Index>(i))) {
+      const std::size_t at = fill[static_cast<std::size_t>(w.aggregate)]++;
+      member_vertex_[at] = static_cast<Index>(i);
+      member_value_[at] = w.value;
+    }
 }
 
 void AggregationCoarseSpace::restrict_to(const BlockVector& r, BlockVector& coarse) const {
@@ -79,7 +83,7 @@ void AggregationCoarseSpace::restrict_to(const BlockVector& r, BlockVector& coar
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     for (std::size_t k = member_start_[static_cast<std::size_t>(a)]; k < member_start_[static_cast<std::size_t>(a) + 1];
          ++k)
-      sum += members_[k].value * block_at(r, members_[k].aggregate);  // .aggregate holds the vertex here
+      sum += member_value_[k] * block_at(r, member_vertex_[k]);
     block_at(coarse, a) = sum;
   };
   parallel_for_index(count_, restrict_one, 1024, kSerialAggregatesBelow);

@@ -18,7 +18,6 @@
 #include "numerics/multigrid.h"
 
 #include <memory>
-#include <span>
 #include <vector>
 
 namespace vertexflow {
@@ -38,11 +37,42 @@ class AggregationCoarseSpace {
 
   [[nodiscard]] int size() const { return count_; }
   [[nodiscard]] Index num_vertices() const { return n_; }
+  /// Weights kept as two arrays, of indices and of values: a Weight of both takes 16 bytes with
+  /// its padding, the two 12 (a fifth of the coarse space, 20 bytes per vertex). Iterating gives
+  /// each as a Weight by value.
+  class Weights {
+   public:
+    class iterator {
+     public:
+      iterator(const Index* index, const double* value) : index_(index), value_(value) {}
+      Weight operator*() const { return {*index_, *value_}; }
+      iterator& operator++() {
+        ++index_, ++value_;
+        return *this;
+      }
+      bool operator!=(const iterator& other) const { return index_ != other.index_; }
+
+     private:
+      const Index* index_;
+      const double* value_;
+    };
+    Weights(const Index* index, const double* value, std::size_t size) : index_(index), value_(value), size_(size) {}
+    [[nodiscard]] iterator begin() const { return {index_, value_}; }
+    [[nodiscard]] iterator end() const { return {index_ + size_, value_ + size_}; }
+    [[nodiscard]] std::size_t size() const { return size_; }
+
+   private:
+    const Index* index_;
+    const double* value_;
+    std::size_t size_;
+  };
+
   /// The basis functions non-zero at vertex i, sorted by aggregate: phi_a = (I - omega (I - W))
   /// chi_a on free vertices, W the one-ring average, chi_a the indicator of aggregate a.
-  [[nodiscard]] std::span<const Weight> basis(Index i) const {
+  [[nodiscard]] Weights basis(Index i) const {
     const auto v = static_cast<std::size_t>(i);
-    return {basis_.data() + basis_start_[v], basis_start_[v + 1] - basis_start_[v]};
+    return {basis_aggregate_.data() + basis_start_[v], basis_value_.data() + basis_start_[v],
+            basis_start_[v + 1] - basis_start_[v]};
   }
   /// coarse = Phi^T r (3 per aggregate).
   void restrict_to(const BlockVector& r, BlockVector& coarse) const;
@@ -51,8 +81,10 @@ class AggregationCoarseSpace {
   Index n_ = 0;
   int count_ = 0;
   std::vector<std::size_t> basis_start_, member_start_;
-  std::vector<Weight> basis_;    // per vertex: (aggregate, phi_a(i))
-  std::vector<Weight> members_;  // per aggregate: (vertex, phi_a(i))
+  std::vector<Index> basis_aggregate_;  // per vertex: the aggregates a with phi_a(i) != 0, and
+  std::vector<double> basis_value_;     // phi_a(i)
+  std::vector<Index> member_vertex_;    // per aggregate: the vertices i with phi_a(i) != 0, and
+  std::vector<double> member_value_;    // phi_a(i)
 };
 
 /// The correction Phi M_c Phi^T of a coarse space and its Galerkin matrix.
