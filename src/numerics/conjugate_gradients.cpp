@@ -38,25 +38,26 @@ IterationResult ConjugateGradients::run(int max_iterations, double tolerance) {
   while (result.iterations < max_iterations) {
     // p = z + beta p is still to be done when a previous iteration computed beta.
     const PreconditionedResidual preconditioned =
-        correction_ ? PreconditionedResidual(z_) : PreconditionedResidual(inverse_, r_);
+        correction_ ? PreconditionedResidual(hp_) : PreconditionedResidual(inverse_, r_);
     const double curvature =
         pending_beta_ ? op_.apply_updated(p_, preconditioned, *pending_beta_, hp_) : op_.apply(p_, hp_);
     pending_beta_.reset();
     if (!(curvature > 0)) break;  // H is positive definite; only rounding at convergence gets here
     const double alpha = rz_ / curvature;
     alphas_.push_back(alpha);
-    // d += alpha p, r -= alpha H p, z = B r; sums of r.r and r.z.
+    // d += alpha p, r -= alpha H p, z = B r (stored over H p, block by block after reading it);
+    // sums of r.r and r.z.
     const Eigen::Vector2d sums = sum_over_vertices(blocks_, Eigen::Vector2d::Zero().eval(), [&](Index i) {
       block_at(d_, i) += alpha * block_at(p_, i);
       const Eigen::Vector3d r = block_at(r_, i) - alpha * block_at(hp_, i);
       const Eigen::Vector3d z = inverse_[static_cast<std::size_t>(i)] * r;
       block_at(r_, i) = r;
-      if (correction_) block_at(z_, i) = z;
+      if (correction_) block_at(hp_, i) = z;
       return Eigen::Vector2d(r.squaredNorm(), r.dot(z));
     });
     r_norm_ = std::sqrt(sums[0]);
     double rz = sums[1];
-    if (correction_) rz = correction_->add_to(r_, z_);
+    if (correction_) rz = correction_->add_to(r_, hp_);
     ++result.iterations;
     ++total_iterations_;
     if (r_norm_ <= target) {
@@ -88,11 +89,11 @@ double ConjugateGradients::predicted_iterations(double tolerance) const {
 
 void ConjugateGradients::use_correction(PreconditionerCorrection* correction) {
   correction_ = correction;
-  z_.resize(r_.size());
+  // z in hp_'s storage (free between iterations).
   parallel_for_index(blocks_,
-                     [&](Index i) { block_at(z_, i) = inverse_[static_cast<std::size_t>(i)] * block_at(r_, i); });
-  rz_ = correction_->add_to(r_, z_);
-  p_ = z_;
+                     [&](Index i) { block_at(hp_, i) = inverse_[static_cast<std::size_t>(i)] * block_at(r_, i); });
+  rz_ = correction_->add_to(r_, hp_);
+  p_ = hp_;
   pending_beta_.reset();
   alphas_.clear();
   betas_.clear();
