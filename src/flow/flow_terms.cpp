@@ -13,8 +13,9 @@ FlowTerms make_flow_terms(const Topology& topology, const std::vector<char>& fix
   t.n = static_cast<Index>(frame.P.rows());
   const auto n = static_cast<std::size_t>(t.n);
   t.original = std::move(order);
-  t.local.resize(n);
-  for (std::size_t k = 0; k < n; ++k) t.local[static_cast<std::size_t>(t.original[k])] = static_cast<Index>(k);
+  // Mesh vertex -> local index, for the rings only: not kept through the solve (4 bytes a vertex).
+  std::vector<Index> local(n);
+  for (std::size_t k = 0; k < n; ++k) local[static_cast<std::size_t>(t.original[k])] = static_cast<Index>(k);
   t.ring_start.resize(n + 1);
   t.ring_start[0] = 0;
   for (std::size_t k = 0; k < n; ++k) t.ring_start[k + 1] = t.ring_start[k] + topology.valence(t.original[k]);
@@ -25,7 +26,7 @@ FlowTerms make_flow_terms(const Topology& topology, const std::vector<char>& fix
     t.fixed[static_cast<std::size_t>(k)] = fixed[static_cast<std::size_t>(v)];
     const auto [begin, end] = topology.ring(v);
     Index* out = t.ring.data() + t.ring_start[static_cast<std::size_t>(k)];
-    for (const Index* j = begin; j != end; ++j) *out++ = t.local[static_cast<std::size_t>(*j)];
+    for (const Index* j = begin; j != end; ++j) *out++ = local[static_cast<std::size_t>(*j)];
   });
   t.K.assign_zero(n);
   t.G.assign_zero(n);

@@ -37,7 +37,6 @@ namespace vertexflow {
 struct FlowTerms {
   Index n = 0;
   std::vector<Index> original;          ///< local index -> mesh vertex
-  std::vector<Index> local;             ///< mesh vertex -> local index
   std::vector<Index> ring_start, ring;  ///< one-rings in local indices
   std::vector<char> fixed;
   Sym3fGroups K;                      ///< K_i
