@@ -47,26 +47,19 @@ struct UnionFind {
   }
 };
 
-// Fans of at most this many faces are ordered by order_small_fan.
+// Fans of at most this many faces find a link vertex's wedges by scanning the fan's 2 count
+// ends; larger ones (a cone apex can have thousands of faces) sort the ends once and search
+// them. For the usual 4-8 faces the scan costs a third of the sort and its searches
+// (bench_topology), which were the largest part of build_topology.
 constexpr Index kSmallFan = 32;
 
-// order_one_ring for count <= kSmallFan, with the same results: each link vertex's wedges are
-// found by scanning the fan's 2 count ends rather than by sorting them and searching, and the
-// visited wedges are bits. Where a vertex has the usual 4-8 faces this costs a third of the
-// sort and its searches (bench_topology), which were the largest part of build_topology.
-bool order_small_fan(Index v, const Faces& F, Index* faces, Index count, Index* ring, Index ring_size) {
-  if (count < 1) return false;       // build_topology skips isolated vertices
-  Index a[kSmallFan], b[kSmallFan];  // wedge w spans link vertices a[w] -> b[w]
-  for (Index w = 0; w < count; ++w) {
-    const Index f = faces[w];
-    const int c = F(f, 0) == v ? 0 : F(f, 1) == v ? 1 : 2;
-    a[w] = F(f, (c + 1) % 3), b[w] = F(f, (c + 2) % 3);
-  }
-  auto degree = [&](Index link_vertex) {
-    Index d = 0;
-    for (Index w = 0; w < count; ++w) d += (a[w] == link_vertex) + (b[w] == link_vertex);
-    return d;
-  };
+// Chains the wedges of a vertex's fan (wedge w: face faces[w], spanning link vertices a[w] ->
+// b[w]) into its ring, and reorders `faces` to match. degree(x): the number of wedges with link
+// vertex x; other_wedge(x, w): the wedge at x other than w, or -1. `visited` holds count zeroed
+// flags, `ordered` room for count faces. Returns false if the wedges are not one fan.
+template <class Degree, class OtherWedge>
+bool walk_fan(Index* faces, Index count, const Index* a, const Index* b, Index* ring, Index ring_size, Degree&& degree,
+              OtherWedge&& other_wedge, char* visited, Index* ordered) {
   // Every link vertex in one or two wedges; each wedge end of degree 1 is a path end.
   Index ends = 0;
   for (Index w = 0; w < count; ++w)
@@ -77,7 +70,8 @@ bool order_small_fan(Index v, const Faces& F, Index* faces, Index count, Index* 
     }
   if (ends != 0 && ends != 2) return false;
   if ((ends == 0 ? count : count + 1) != ring_size) return false;
-  // The start: as order_one_ring.
+  // Start: on a path, at the end that is the 'a' of its wedge, so the walk follows the faces'
+  // orientation when it is consistent (else at a 'b' end); on a cycle, at wedge 0.
   Index wedge = 0, current = a[0];
   if (ends == 2) {
     wedge = -1;
@@ -87,13 +81,11 @@ bool order_small_fan(Index v, const Faces& F, Index* faces, Index count, Index* 
       if (degree(b[w]) == 1) wedge = w, current = b[w];
   }
   const Index start_vertex = current;
-  Index ordered[kSmallFan];
-  std::uint32_t visited = 0;
   Index filled = 0;
   ring[filled++] = current;
   for (Index step = 0; step < count; ++step) {
-    if (visited >> wedge & 1u) return false;  // a wedge twice: more than one fan
-    visited |= 1u << wedge;
+    if (visited[wedge]) return false;  // a wedge twice: more than one fan
+    visited[wedge] = 1;
     ordered[step] = faces[wedge];
     current = current == a[wedge] ? b[wedge] : a[wedge];
     if (step + 1 < count || ends == 2) {
@@ -101,11 +93,8 @@ bool order_small_fan(Index v, const Faces& F, Index* faces, Index count, Index* 
       ring[filled++] = current;
     }
     if (step + 1 < count) {
-      Index next = -1;  // the other wedge at `current` (it has at most two)
-      for (Index w = 0; w < count && next < 0; ++w)
-        if (w != wedge && (a[w] == current || b[w] == current)) next = w;
-      if (next < 0) return false;  // the chain broke: more than one fan
-      wedge = next;
+      wedge = other_wedge(current, wedge);
+      if (wedge < 0) return false;  // the chain broke: more than one fan
     }
   }
   if (ends == 0 && current != start_vertex) return false;
@@ -117,92 +106,58 @@ bool order_small_fan(Index v, const Faces& F, Index* faces, Index count, Index* 
 // wedge (next corner, previous corner); at a manifold vertex the wedges chain into one path
 // (boundary) or one cycle. Returns false if they do not (non-manifold vertex).
 bool order_one_ring(Index v, const Faces& F, Index* faces, Index count, Index* ring, Index ring_size) {
-  if (count <= kSmallFan) return order_small_fan(v, F, faces, count, ring, ring_size);
-  // Per-thread buffers: this runs once per vertex, so no allocation per call.
-  thread_local std::vector<std::pair<Index, Index>> incidence_buffer;
-  thread_local std::vector<Index> ordered_faces;
-  thread_local std::vector<Index> check;
-  // Wedge w spans link vertices a(w) -> b(w).
-  auto corner = [&](Index f) { return F(f, 0) == v ? 0 : F(f, 1) == v ? 1 : 2; };
-  auto a_of = [&](Index f) { return F(f, (corner(f) + 1) % 3); };
-  auto b_of = [&](Index f) { return F(f, (corner(f) + 2) % 3); };
-
-  // Incidence list of the link graph: (link vertex, wedge), sorted by link vertex.
-  incidence_buffer.resize(2 * static_cast<std::size_t>(count));
-  std::pair<Index, Index>* incidence = incidence_buffer.data();
+  if (count < 1) return false;  // build_topology skips isolated vertices
+  // Large fans' buffers are per thread: this runs once per vertex, so no allocation per call.
+  thread_local std::vector<Index> large_ends, large_ordered;
+  thread_local std::vector<char> large_visited;
+  thread_local std::vector<std::pair<Index, Index>> incidence;
+  Index small_ends[2 * kSmallFan], small_ordered[kSmallFan];
+  char small_visited[kSmallFan] = {};
+  const bool small = count <= kSmallFan;
+  if (!small) {
+    large_ends.resize(2 * static_cast<std::size_t>(count));
+    large_ordered.resize(static_cast<std::size_t>(count));
+    large_visited.assign(static_cast<std::size_t>(count), 0);
+  }
+  Index* a = small ? small_ends : large_ends.data();
+  Index* b = a + count;
   for (Index w = 0; w < count; ++w) {
-    incidence[2 * w] = {a_of(faces[w]), w};
-    incidence[2 * w + 1] = {b_of(faces[w]), w};
+    const Index f = faces[w];
+    const int c = F(f, 0) == v ? 0 : F(f, 1) == v ? 1 : 2;
+    a[w] = F(f, (c + 1) % 3), b[w] = F(f, (c + 2) % 3);
   }
-  std::sort(incidence, incidence + 2 * count);
-  // Every link vertex must be in one or two wedges; count the path ends.
-  Index ends = 0;
-  for (Index i = 0; i < 2 * count;) {
-    Index j = i;
-    while (j < 2 * count && incidence[j].first == incidence[i].first) ++j;
-    if (j - i > 2) return false;
-    if (j - i == 1) ++ends;
-    i = j;
+  if (small) {
+    auto degree = [&](Index x) {
+      Index d = 0;
+      for (Index w = 0; w < count; ++w) d += (a[w] == x) + (b[w] == x);
+      return d;
+    };
+    auto other_wedge = [&](Index x, Index wedge) {
+      for (Index w = 0; w < count; ++w)
+        if (w != wedge && (a[w] == x || b[w] == x)) return w;
+      return Index{-1};
+    };
+    return walk_fan(faces, count, a, b, ring, ring_size, degree, other_wedge, small_visited, small_ordered);
   }
-  if (ends != 0 && ends != 2) return false;
-  const Index expected_ring = ends == 0 ? count : count + 1;
-  if (expected_ring != ring_size) return false;
-
-  auto other_wedge = [&](Index link_vertex, Index wedge) -> Index {
-    const auto* it = std::lower_bound(incidence, incidence + 2 * count, std::make_pair(link_vertex, Index{-1}));
-    for (; it != incidence + 2 * count && it->first == link_vertex; ++it) {
-      if (it->second != wedge) return it->second;
-    }
-    return -1;
+  // (link vertex, wedge), sorted by link vertex.
+  incidence.resize(2 * static_cast<std::size_t>(count));
+  for (Index w = 0; w < count; ++w)
+    incidence[2 * static_cast<std::size_t>(w)] = {a[w], w}, incidence[2 * static_cast<std::size_t>(w) + 1] = {b[w], w};
+  std::sort(incidence.begin(), incidence.end());
+  auto first_at = [&](Index x) {
+    return std::lower_bound(incidence.begin(), incidence.end(), std::pair{x, Index{-1}});
   };
-  auto degree = [&](Index link_vertex) {
-    const auto* lo = std::lower_bound(incidence, incidence + 2 * count, std::make_pair(link_vertex, Index{-1}));
+  auto degree = [&](Index x) {
     Index d = 0;
-    for (; lo != incidence + 2 * count && lo->first == link_vertex; ++lo) ++d;
+    for (auto it = first_at(x); it != incidence.end() && it->first == x; ++it) ++d;
     return d;
   };
-
-  // Start: on a path, at the end that is the 'a' of its wedge, so the walk follows the faces'
-  // orientation when it is consistent; on a cycle, at wedge 0.
-  Index start_wedge = 0;
-  Index start_vertex = a_of(faces[0]);
-  if (ends == 2) {
-    start_wedge = -1;
-    for (Index w = 0; w < count && start_wedge < 0; ++w) {
-      if (degree(a_of(faces[w])) == 1) start_wedge = w, start_vertex = a_of(faces[w]);
-    }
-    if (start_wedge < 0) {  // inconsistent orientation: start at a 'b' end instead
-      for (Index w = 0; w < count && start_wedge < 0; ++w) {
-        if (degree(b_of(faces[w])) == 1) start_wedge = w, start_vertex = b_of(faces[w]);
-      }
-    }
-  }
-  ordered_faces.clear();
-  Index wedge = start_wedge;
-  Index current = start_vertex;
-  Index filled = 0;
-  ring[filled++] = current;
-  for (Index step = 0; step < count; ++step) {
-    const Index f = faces[wedge];
-    ordered_faces.push_back(f);
-    const Index a = a_of(f), b = b_of(f);
-    current = current == a ? b : a;
-    if (step + 1 < count || ends == 2) {
-      if (filled >= ring_size) return false;
-      ring[filled++] = current;
-    }
-    if (step + 1 < count) {
-      wedge = other_wedge(current, wedge);
-      if (wedge < 0) return false;  // the chain broke: more than one fan
-    }
-  }
-  if (ends == 0 && current != start_vertex) return false;
-  // Every wedge visited exactly once?
-  check.assign(ordered_faces.begin(), ordered_faces.end());
-  std::sort(check.begin(), check.end());
-  if (std::adjacent_find(check.begin(), check.end()) != check.end()) return false;
-  std::copy(ordered_faces.begin(), ordered_faces.end(), faces);
-  return filled == ring_size;
+  auto other_wedge = [&](Index x, Index wedge) {
+    for (auto it = first_at(x); it != incidence.end() && it->first == x; ++it)
+      if (it->second != wedge) return it->second;
+    return Index{-1};
+  };
+  return walk_fan(faces, count, a, b, ring, ring_size, degree, other_wedge, large_visited.data(), large_ordered.data());
 }
 
 }  // namespace
