@@ -65,7 +65,7 @@ struct EnhanceMemoryPlan {
 ///   space): the plan runs that instead of refusing, and `note` says so. Automatic's output
 ///   bytes then depend on the memory available as well as on the mesh; both paths stop at the
 ///   same relative residual (FlowOptions::solver_tolerance), so the vertices differ by far less
-///   than an edge length (docs/benchmarks.md, "Solver tolerance 1e-6").
+///   than an edge length (docs/benchmarks.md, "Solver tolerance 1e-4").
 /// - otherwise throws InsufficientMemoryError("PATH: enhancing N vertices[ with a report] needs
 ///   about X GiB at its peak (...; H GiB of it held already), but only Y GiB more is available
 ///   (limited_by)"), X the estimate of the lightest path allowed. An explicit solver is never

@@ -341,9 +341,9 @@ TEST(FlowSolver, FlowOptionsSelectTheSolver) {
     options.solver = kind;
     const FlowResult iterative = vertex_flow(mesh.V, mesh.F, options);
     EXPECT_EQ(iterative.report.solver_used, kind);
-    // At the default tolerance (1e-6): measured 2.4e-5 (block-Jacobi) and 1.2e-5 (multilevel)
-    // mean edge lengths, as flow.h gives for solver_tolerance.
-    EXPECT_LT(max_difference(direct.V, iterative.V), 6e-5 * direct.report.mean_edge_length);
+    // At the default tolerance (1e-4): measured 3.1e-3 (block-Jacobi) and 1.1e-3 (multilevel)
+    // mean edge lengths, within what flow.h gives for solver_tolerance.
+    EXPECT_LT(max_difference(direct.V, iterative.V), 1e-2 * direct.report.mean_edge_length);
   }
 }
 
