@@ -69,6 +69,18 @@ BlockSparseMatrix symmetric_from_upper(const BlockSparseMatrix& upper);
 std::vector<int> aggregate_nodes(const std::vector<int>& start, const std::vector<int>& neighbours,
                                  const std::vector<char>& excluded, int& count);
 
+/// The smoothed-aggregation prolongator from A's nodes to `count` aggregates (aggregate[k] of
+/// node k, as aggregate_nodes gives): P = (I - omega B A) P_t, with P_t the translations of each
+/// aggregate (block I / sqrt(|a|) on its nodes, so that its columns have unit length) and B =
+/// `block_inverse`, A's inverse diagonal blocks. Then, in each row, every block but the own
+/// aggregate's whose Frobenius norm is below `truncation` times the row's largest is dropped
+/// and lumped into the own aggregate's block, scaled so that P still maps each coarse
+/// translation (c_a = sqrt(|a|) t, which P_t maps to t on every node) to (I - omega B A) t:
+/// narrower rows, the same near null space. `truncation` 0 keeps every block. Deterministic.
+BlockSparseMatrix smoothed_prolongator(const BlockSparseMatrix& A, const std::vector<int>& aggregate, int count,
+                                       const std::vector<Eigen::Matrix3d>& block_inverse, double omega,
+                                       double truncation);
+
 /// The additive multilevel operator M = B_0 + P_1 (B_1 + P_2 (... + A_L^-1 ...) P_2^T) P_1^T,
 /// with B_l the inverses of level l's 3x3 diagonal blocks and A_L the coarsest Galerkin matrix,
 /// factored densely; where coarsening stalls on a level of more than max(coarsest_unknowns,
