@@ -6,8 +6,9 @@
 // (hypre, PETSc, Trilinos), and AMGCL, the header-only reference for the method, is not
 // packaged. The hierarchy is Vanek, Mandel and Brezina's smoothed aggregation (Computing 56,
 // 1996): aggregates of strongly coupled nodes, the three translations as near null space, the
-// tentative prolongator smoothed by one damped block-Jacobi step, Galerkin coarse matrices and
-// a dense Cholesky factorisation on the coarsest level. The levels are combined additively
+// tentative prolongator smoothed by one damped block-Jacobi step and truncated
+// (smoothed_prolongator), Galerkin coarse matrices and a dense Cholesky factorisation on the
+// coarsest level. The levels are combined additively
 // (BPX style, block-Jacobi on each level) rather than in a V-cycle: measured on fandisk's
 // coarse problem, a Gauss-Seidel V-cycle took 20% fewer outer iterations but each cost 1.5x
 // more, since its sweeps are sequential. The matrices are kept as 3x3 blocks throughout (not
