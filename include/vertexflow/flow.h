@@ -169,8 +169,8 @@ struct FlowOptions {
   /// residual b). Measured against a 1e-13 solve (largest / mean vertex distance from its
   /// position there, in mean edge lengths, on fandisk, camelhead, bunny_uniform, amo and
   /// horse-48k; the iteration counts of bunny_uniform and the 1M-vertex armadillo): 1e-6 within
-  /// 2e-4 / 2e-5 (65 and 142 iterations), 1e-5 within 5e-3 / 2e-4 (52 and 111), 1e-4 within
-  /// 2.7e-2 / 1.8e-3 (37 and 85; camelhead's largest, 0.11, is one vertex the guard halved
+  /// 1.1e-3 / 1.9e-5 (65 and 142 iterations), 1e-5 within 3.8e-3 / 2.7e-4 (52 and 111), 1e-4
+  /// within 3.7e-2 / 2.4e-3 (37 and 85; camelhead's largest, 0.11, is a vertex the guard halved
   /// differently). The flow moves vertices by 0.1-3 mean edge lengths and projects them onto
   /// the input afterwards, and every figure of bench/make_results.py stayed within 0.5% between
   /// 1e-6 and 1e-4 (but a sliver's quality, 8.0e-5 against 7.4e-5, and a zero at rounding
