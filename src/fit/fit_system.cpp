@@ -265,7 +265,7 @@ class IterativeFitSystem final : public FitSystem, BlockOperator {
     w_stay_ = options.proximity / static_cast<double>(n_);
     // Block-Jacobi: the diagonal of the whole matrix, (L^T L)_ii = L_ii^2 + sum over the ring
     // of 1 / valence_k^2.
-    std::vector<Sym3> inverse(static_cast<std::size_t>(n_));
+    std::vector<InverseFactor3f> inverse(static_cast<std::size_t>(n_));
     parallel_for_index(n_, [&](Index i) {
       if (!is_free(i)) return;
       double diagonal = values_[static_cast<std::size_t>(row_start_[static_cast<std::size_t>(i)])] + w_stay_;
@@ -276,8 +276,7 @@ class IterativeFitSystem final : public FitSystem, BlockOperator {
           laplacian += inverse_valence_[static_cast<std::size_t>(*k)] * inverse_valence_[static_cast<std::size_t>(*k)];
         diagonal += w_fair_ * laplacian;
       }
-      Sym3& s = inverse[static_cast<std::size_t>(i)];
-      s.xx = s.yy = s.zz = 1.0 / diagonal;
+      inverse[static_cast<std::size_t>(i)] = InverseFactor3f::scalar(1.0 / diagonal);
     });
     if (w_fair_ > 0) laplacian_.resize(b.size());
     ConjugateGradients cg(*this, std::move(inverse), b);

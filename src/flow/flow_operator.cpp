@@ -20,9 +20,9 @@ namespace {
 // K x: x is read where it lies (the vertices are numbered along the surface, so a one-ring's x
 // share cache lines), 24 bytes per vertex fewer and, on one core at 1M vertices, a tenth less
 // solve time (writing the copy cost more than the second gather).
-template <int Size>
-Eigen::Map<Eigen::Matrix<double, Size, 1>> record(std::vector<double>& data, Index i) {
-  return Eigen::Map<Eigen::Matrix<double, Size, 1>>(data.data() + Size * static_cast<std::size_t>(i));
+template <int Size, class Scalar>
+Eigen::Map<Eigen::Matrix<Scalar, Size, 1>> record(std::vector<Scalar>& data, Index i) {
+  return Eigen::Map<Eigen::Matrix<Scalar, Size, 1>>(data.data() + Size * static_cast<std::size_t>(i));
 }
 
 // What vertex i contributes to the Galerkin matrix for aggregate `aggregate`.
@@ -83,21 +83,25 @@ struct Sym3Lanes {
 [[gnu::always_inline]] inline void put(double (&rows)[3][kGroup], int lane, const Eigen::Vector3d& value) {
   rows[0][lane] = value.x(), rows[1][lane] = value.y(), rows[2][lane] = value.z();
 }
-[[gnu::always_inline]] inline void store(double* out, const Vec3Lanes& v, int lane) {
-  out[0] = v.x[lane], out[1] = v.y[lane], out[2] = v.z[lane];
+template <class Scalar>
+[[gnu::always_inline]] inline void store(Scalar* out, const Vec3Lanes& v, int lane) {
+  out[0] = static_cast<Scalar>(v.x[lane]), out[1] = static_cast<Scalar>(v.y[lane]),
+  out[2] = static_cast<Scalar>(v.z[lane]);
 }
 
+template <class Cache>
 struct OperatorData {
   const FlowTerms& t;
   const double* x;  // 3 per vertex
-  const double* kx;
-  double* qkr;
+  const Cache* kx;
+  Cache* qkr;
   double* y;
 };
 
 // Group g of the second pass: q = P (G x - K sum_j x_j - sum_j K_j x_j), K q and r = S (x -
 // sum_j x_j / deg - rest) into each vertex's record.
-[[gnu::target_clones("avx2", "default")]] void second_pass(const OperatorData& d, bool with_rest, Index g) {
+template <class Cache>
+[[gnu::target_clones("avx2", "default")]] void second_pass(const OperatorData<Cache>& d, bool with_rest, Index g) {
   const FlowTerms& t = d.t;
   const Index first = kGroup * g;
   const int count = static_cast<int>(std::min<Index>(kGroup, t.n - first));
@@ -113,7 +117,8 @@ struct OperatorData {
     Eigen::Vector3d sx = Eigen::Vector3d::Zero(), skx = Eigen::Vector3d::Zero();
     for (const Index* j = begin; j != end; ++j) {
       sx += Eigen::Map<const Eigen::Vector3d>(d.x + 3 * static_cast<std::ptrdiff_t>(*j));
-      skx += Eigen::Map<const Eigen::Vector3d>(d.kx + 3 * static_cast<std::ptrdiff_t>(*j));
+      skx += Eigen::Map<const Eigen::Matrix<Cache, 3, 1>>(d.kx + 3 * static_cast<std::ptrdiff_t>(*j))
+                 .template cast<double>();
     }
     put(sum_x, l, sx);
     put(sum_kx, l, skx);
@@ -147,7 +152,7 @@ struct OperatorData {
   // third pass reads it there and writes y: no 1 / deg(j) to gather per neighbour.
   const Vec3Lanes r_by_degree{s * r.x, s * r.y, s * r.z};
   for (int l = 0; l < count; ++l) {
-    double* out = d.qkr + 9 * static_cast<std::ptrdiff_t>(first + l);
+    Cache* out = d.qkr + 9 * static_cast<std::ptrdiff_t>(first + l);
     store(out, q, l), store(out + 3, kq, l), store(out + 6, r_by_degree, l);
     store(d.y + 3 * static_cast<std::ptrdiff_t>(first + l), r, l);
   }
@@ -156,7 +161,9 @@ struct OperatorData {
 // Groups [g0, g1) of the third pass: y = G q - K sum_j q_j - sum_j K_j q_j + r - sum_j r_j /
 // deg(j) (+ D x), zero at fixed vertices; returns the sum of x . y over the groups' vertices, in
 // order.
-[[gnu::target_clones("avx2", "default")]] double third_pass(const OperatorData& d, bool with_d, Index g0, Index g1) {
+template <class Cache>
+[[gnu::target_clones("avx2", "default")]] double third_pass(const OperatorData<Cache>& d, bool with_d, Index g0,
+                                                            Index g1) {
   const FlowTerms& t = d.t;
   double total = 0;
   for (Index g = g0; g < g1; ++g) {
@@ -170,11 +177,14 @@ struct OperatorData {
       const auto [begin, end] = t.one_ring(u);
       Eigen::Matrix<double, 9, 1> sum = Eigen::Matrix<double, 9, 1>::Zero();
       for (const Index* j = begin; j != end; ++j)
-        sum += Eigen::Map<const Eigen::Matrix<double, 9, 1>>(d.qkr + 9 * static_cast<std::ptrdiff_t>(*j));
+        sum += Eigen::Map<const Eigen::Matrix<Cache, 9, 1>>(d.qkr + 9 * static_cast<std::ptrdiff_t>(*j))
+                   .template cast<double>();
       put(sum_q, l, sum.head<3>());
       put(sum_kq, l, sum.segment<3>(3));
       put(sum_r, l, sum.tail<3>());
-      put(own_q, l, Eigen::Map<const Eigen::Vector3d>(d.qkr + 9 * static_cast<std::ptrdiff_t>(u)));
+      put(own_q, l,
+          Eigen::Map<const Eigen::Matrix<Cache, 3, 1>>(d.qkr + 9 * static_cast<std::ptrdiff_t>(u))
+              .template cast<double>());
       put(own_r, l, Eigen::Map<const Eigen::Vector3d>(d.y + 3 * static_cast<std::ptrdiff_t>(u)));
       put(own_x, l, Eigen::Map<const Eigen::Vector3d>(d.x + 3 * static_cast<std::ptrdiff_t>(u)));
     }
@@ -210,11 +220,19 @@ struct OperatorData {
 
 }  // namespace
 
-FlowOperator::FlowOperator(const FlowTerms& terms) : t_(terms) {}
+FlowOperator::FlowOperator(const FlowTerms& terms, CachePrecision precision) : t_(terms), precision_(precision) {}
+
+void FlowOperator::use_cache_precision(CachePrecision precision) {
+  if (precision == precision_) return;
+  release_caches();
+  precision_ = precision;
+}
 
 void FlowOperator::release_caches() {
-  std::vector<double>().swap(kx_);
-  std::vector<double>().swap(qkr_);
+  std::vector<float>().swap(kx_float_);
+  std::vector<float>().swap(qkr_float_);
+  std::vector<double>().swap(kx_double_);
+  std::vector<double>().swap(qkr_double_);
 }
 
 double FlowOperator::apply(const BlockVector& x, BlockVector& y) {
@@ -239,14 +257,22 @@ BlockVector FlowOperator::right_hand_side(const BlockVector& x) {
 // first(i) gives x_i (and may write it) in the first pass; the later passes read x.
 template <class First>
 double FlowOperator::passes(const BlockVector& x, BlockVector& y, bool with_d, bool with_rest, First&& first) {
+  return precision_ == CachePrecision::Float
+             ? passes(kx_float_, qkr_float_, x, y, with_d, with_rest, std::forward<First>(first))
+             : passes(kx_double_, qkr_double_, x, y, with_d, with_rest, std::forward<First>(first));
+}
+
+template <class Cache, class First>
+double FlowOperator::passes(std::vector<Cache>& kx, std::vector<Cache>& qkr, const BlockVector& x, BlockVector& y,
+                            bool with_d, bool with_rest, First&& first) {
   const auto n = static_cast<std::size_t>(t_.n);
-  if (kx_.size() != 3 * n) kx_.resize(3 * n);
-  if (qkr_.size() != 9 * n) qkr_.resize(9 * n);
+  if (kx.size() != 3 * n) kx.resize(3 * n);
+  if (qkr.size() != 9 * n) qkr.resize(9 * n);
   parallel_for_index(t_.n, [&](Index i) {
     const Eigen::Vector3d xi = first(i);
-    record<3>(kx_, i) = t_.K[static_cast<std::size_t>(i)] * xi;
+    record<3>(kx, i) = (t_.K[static_cast<std::size_t>(i)] * xi).template cast<Cache>();
   });
-  const OperatorData data{t_, x.data(), kx_.data(), qkr_.data(), y.data()};
+  const OperatorData<Cache> data{t_, x.data(), kx.data(), qkr.data(), y.data()};
   const Index groups = (t_.n + kGroup - 1) / kGroup;
   parallel_for_index(
       groups, [&](Index g) { second_pass(data, with_rest, g); }, kGroupsPerTask);

@@ -18,7 +18,17 @@ namespace vertexflow {
 /// iteration is as much bound by arithmetic as by memory here). Rows of fixed vertices are zero.
 class FlowOperator : public BlockOperator {
  public:
-  explicit FlowOperator(const FlowTerms& terms);
+  /// How the passes keep K x and (q, K q, r) between them. Double: H x exactly as the factors
+  /// define it (to double rounding). Float: 48 bytes per vertex instead of 96, part of the
+  /// solve's peak memory, at the same speed (the passes are bound by arithmetic); each product
+  /// then carries a rounding of about 3e-8 relative (the residual of an exact solution measured
+  /// through it: 2e-8 to 8e-8 on the data meshes), so it serves iterations stopped well above
+  /// that (FlowSystemSolver's iterations at tolerances of 1e-6 and more).
+  enum class CachePrecision { Double, Float };
+
+  explicit FlowOperator(const FlowTerms& terms, CachePrecision precision = CachePrecision::Double);
+  /// Products from here on keep their caches in `precision` (the other's are freed).
+  void use_cache_precision(CachePrecision precision);
 
   double apply(const BlockVector& x, BlockVector& y) override;
   double apply_updated(BlockVector& p, const PreconditionedResidual& z, double beta, BlockVector& y) override;
@@ -27,18 +37,23 @@ class FlowOperator : public BlockOperator {
   /// half-gradient of the energy at d = 0, the normal equations' right-hand side (D drops out).
   BlockVector right_hand_side(const BlockVector& x);
 
-  /// Frees the per-vertex caches (96 bytes per vertex) until the next product allocates them
-  /// again: the multilevel set-up, the flow's peak on that path, runs between b and the first
-  /// product and does not need them.
+  /// Frees the per-vertex caches (96 or 48 bytes per vertex) until the next product allocates
+  /// them again: the multilevel set-up, one of the flow's peaks on that path, runs between b and
+  /// the first product and does not need them.
   void release_caches();
 
  private:
   template <class First>
   double passes(const BlockVector& x, BlockVector& y, bool with_d, bool with_rest, First&& first);
+  template <class Cache, class First>
+  double passes(std::vector<Cache>& kx, std::vector<Cache>& qkr, const BlockVector& x, BlockVector& y, bool with_d,
+                bool with_rest, First&& first);
 
   const FlowTerms& t_;
-  std::vector<double> kx_;   // per vertex: K x
-  std::vector<double> qkr_;  // per vertex: q, K q, r
+  CachePrecision precision_;
+  // Per vertex: K x, and q, K q, r; in the precision chosen (the other pair stays empty).
+  std::vector<float> kx_float_, qkr_float_;
+  std::vector<double> kx_double_, qkr_double_;
 };
 
 /// The upper half (diagonal included) of the Galerkin matrix Phi^T H Phi, summed vertex by

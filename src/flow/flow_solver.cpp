@@ -72,6 +72,11 @@ constexpr double kBudgetPerSqrtVertex = 18.0;
 // data mesh at most 105 vertices. Starting multilevel at once saves the probe below.
 constexpr double kFlatCurvature = 0.01;
 constexpr Index kFlatRegionForMultilevel = 500;
+// The iterations' products keep the operator's per-vertex caches in float (flow_operator.h: 48
+// bytes per vertex less at the solve's peak) where they stop at a relative residual of at least
+// this, 30 times those products' rounding (about 3e-8); tighter tolerances get exact products,
+// as b, the direct path and the reported residual always do.
+constexpr double kFloatCachesFromTolerance = 1e-6;
 // Otherwise block-Jacobi runs kProbeIterations, and if the Lanczos estimate of its total
 // (ConjugateGradients::predicted_iterations, a lower bound) is above kSwitchAbovePredicted the
 // iteration continues with the multilevel preconditioner. The set-up costs about 30-50
@@ -160,11 +165,11 @@ std::unique_ptr<CoarseSpaceCorrection> make_multilevel(const FlowTerms& terms) {
 
 // The inverses of H's diagonal blocks (zero at fixed vertices): block-Jacobi, which captures
 // each vertex's anisotropy (stiff along the normal, soft in the tangent plane) exactly.
-std::vector<Sym3> block_jacobi(const FlowTerms& t) {
-  std::vector<Sym3> inverse(static_cast<std::size_t>(t.n));
+std::vector<InverseFactor3f> block_jacobi(const FlowTerms& t) {
+  std::vector<InverseFactor3f> inverse(static_cast<std::size_t>(t.n));
   parallel_for_index(t.n, [&](Index u) {
     const auto v = static_cast<std::size_t>(u);
-    if (!t.fixed[v]) inverse[v] = Sym3(Eigen::Matrix3d(diagonal_block(t, u).inverse()));
+    if (!t.fixed[v]) inverse[v] = InverseFactor3f::of_inverse(diagonal_block(t, u));
   });
   return inverse;
 }
@@ -278,7 +283,7 @@ Vertices FlowSystemSolver::solve(const FlowFrame& frame, FlowFrame* release, con
     release->curvature = Curvature();
     std::vector<Eigen::Matrix3d>().swap(release->sliver_stiffness);
   }
-  FlowOperator op(terms);
+  FlowOperator op(terms);  // exact products for b; the iterations may round (kFloatCachesFromTolerance)
   const BlockVector b = op.right_hand_side(to_local(terms, frame.P.data()));
   // The fairness targets enter b only: 24 bytes per vertex that the solve, the flow's peak, does
   // not read.
@@ -291,7 +296,8 @@ Vertices FlowSystemSolver::solve(const FlowFrame& frame, FlowFrame* release, con
   report.solver_iterations = 0;
   if (!direct && m > 0) {
     start = Clock::now();
-    op.release_caches();  // until the first iteration: the multilevel set-up is this path's peak
+    op.release_caches();  // until the first iteration: the multilevel set-up is one of this path's peaks
+    if (s.tolerance >= kFloatCachesFromTolerance) op.use_cache_precision(FlowOperator::CachePrecision::Float);
     std::unique_ptr<CoarseSpaceCorrection> multilevel;
     if (s.kind == LinearSolver::Multilevel ||
         (s.kind == LinearSolver::Automatic && largest_flat_region(terms) >= kFlatRegionForMultilevel))
@@ -341,8 +347,9 @@ Vertices FlowSystemSolver::solve(const FlowFrame& frame, FlowFrame* release, con
   if (m == 0) d = BlockVector::Zero(b.size());
   report.solver_used = used;
 
-  // The relative residual of the normal equations, independent of the method.
+  // The relative residual of the normal equations, independent of the method (exact products).
   start = Clock::now();
+  op.use_cache_precision(FlowOperator::CachePrecision::Double);
   BlockVector residual(b.size());
   op.apply(d, residual);
   residual -= b;

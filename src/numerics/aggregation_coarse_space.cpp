@@ -59,7 +59,7 @@ AggregationCoarseSpace::AggregationCoarseSpace(const std::vector<Index>& start, 
     const auto v = static_cast<std::size_t>(i);
     for (std::size_t k = 0; k < basis_size[v]; ++k) {
       basis_aggregate_[basis_start_[v] + k] = weights[room[v] + k].aggregate;
-      basis_value_[basis_start_[v] + k] = weights[room[v] + k].value;
+      basis_value_[basis_start_[v] + k] = static_cast<float>(weights[room[v] + k].value);
     }
   });
   std::vector<Weight>().swap(weights);
@@ -74,7 +74,7 @@ AggregationCoarseSpace::AggregationCoarseSpace(const std::vector<Index>& start, 
     for (const Weight& w : basis(static_cast<Index>(i))) {
       const std::size_t at = fill[static_cast<std::size_t>(w.aggregate)]++;
       member_vertex_[at] = static_cast<Index>(i);
-      member_value_[at] = w.value;
+      member_value_[at] = static_cast<float>(w.value);
     }
 }
 
@@ -83,26 +83,16 @@ void AggregationCoarseSpace::restrict_to(const BlockVector& r, BlockVector& coar
     Eigen::Vector3d sum = Eigen::Vector3d::Zero();
     for (std::size_t k = member_start_[static_cast<std::size_t>(a)]; k < member_start_[static_cast<std::size_t>(a) + 1];
          ++k)
-      sum += member_value_[k] * block_at(r, member_vertex_[k]);
+      sum += double(member_value_[k]) * block_at(r, member_vertex_[k]);
     block_at(coarse, a) = sum;
   };
   parallel_for_index(count_, restrict_one, 1024, kSerialAggregatesBelow);
 }
 
-namespace {
-
-// The symmetric matrix, with the upper half freed before the hierarchy is built from it.
-BlockSparseMatrix symmetric_releasing(BlockSparseMatrix& upper) {
-  BlockSparseMatrix symmetric = symmetric_from_upper(upper);
-  upper = BlockSparseMatrix();
-  return symmetric;
-}
-
-}  // namespace
-
 CoarseSpaceCorrection::CoarseSpaceCorrection(std::shared_ptr<const AggregationCoarseSpace> space,
                                              BlockSparseMatrix galerkin_upper)
-    : space_(std::move(space)), coarse_(std::make_unique<AdditiveMultilevel>(symmetric_releasing(galerkin_upper))) {
+    : space_(std::move(space)),
+      coarse_(std::make_unique<AdditiveMultilevel>(std::move(galerkin_upper), AdditiveMultilevel::Storage::UpperHalf)) {
   restricted_.resize(3 * space_->size());
 }
 

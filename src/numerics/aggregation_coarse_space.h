@@ -38,13 +38,15 @@ class AggregationCoarseSpace {
   [[nodiscard]] int size() const { return count_; }
   [[nodiscard]] Index num_vertices() const { return n_; }
   /// Weights kept as two arrays, of indices and of values: a Weight of both takes 16 bytes with
-  /// its padding, the two 12 (a fifth of the coarse space, 20 bytes per vertex). Iterating gives
-  /// each as a Weight by value.
+  /// its padding, the two 8 (a third of the coarse space's bytes). The values are rounded to
+  /// float once, when the space is made, and every use (restriction, prolongation, the
+  /// problem's Galerkin matrix) reads the same rounded phi, so Phi M_c Phi^T stays symmetric
+  /// positive semi-definite. Iterating gives each as a Weight by value, in double.
   class Weights {
    public:
     class iterator {
      public:
-      iterator(const Index* index, const double* value) : index_(index), value_(value) {}
+      iterator(const Index* index, const float* value) : index_(index), value_(value) {}
       Weight operator*() const { return {*index_, *value_}; }
       iterator& operator++() {
         ++index_, ++value_;
@@ -54,16 +56,16 @@ class AggregationCoarseSpace {
 
      private:
       const Index* index_;
-      const double* value_;
+      const float* value_;
     };
-    Weights(const Index* index, const double* value, std::size_t size) : index_(index), value_(value), size_(size) {}
+    Weights(const Index* index, const float* value, std::size_t size) : index_(index), value_(value), size_(size) {}
     [[nodiscard]] iterator begin() const { return {index_, value_}; }
     [[nodiscard]] iterator end() const { return {index_ + size_, value_ + size_}; }
     [[nodiscard]] std::size_t size() const { return size_; }
 
    private:
     const Index* index_;
-    const double* value_;
+    const float* value_;
     std::size_t size_;
   };
 
@@ -82,9 +84,9 @@ class AggregationCoarseSpace {
   int count_ = 0;
   std::vector<std::size_t> basis_start_, member_start_;
   std::vector<Index> basis_aggregate_;  // per vertex: the aggregates a with phi_a(i) != 0, and
-  std::vector<double> basis_value_;     // phi_a(i)
+  std::vector<float> basis_value_;      // phi_a(i)
   std::vector<Index> member_vertex_;    // per aggregate: the vertices i with phi_a(i) != 0, and
-  std::vector<double> member_value_;    // phi_a(i)
+  std::vector<float> member_value_;     // phi_a(i)
 };
 
 /// The correction Phi M_c Phi^T of a coarse space and its Galerkin matrix.

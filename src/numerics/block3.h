@@ -6,9 +6,11 @@
 #include "numerics/parallel.h"
 #include "vertexflow/mesh.h"
 
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
 
 #include <algorithm>
+#include <cmath>
 #include <vector>
 
 namespace vertexflow {
@@ -53,6 +55,44 @@ struct BasicSym3 {
 };
 using Sym3 = BasicSym3<double>;
 using Sym3f = BasicSym3<float>;
+
+/// A symmetric positive definite 3x3 inverse B = M^T M kept as M, lower triangular, in float (24
+/// bytes): block-Jacobi's per-vertex inverses, read at every iteration. Rounding M rather than B
+/// keeps B positive definite however anisotropic the block (stiff along a normal, soft in the
+/// tangent plane), where a rounded B could lose definiteness; B is exactly symmetric and the
+/// same on any processor. Products are in double.
+struct InverseFactor3f {
+  float m00 = 0, m10 = 0, m11 = 0, m20 = 0, m21 = 0, m22 = 0;
+
+  /// B = block^-1, block symmetric positive definite: M = L^-1 with block = L L^T (Cholesky).
+  /// A block that is not numerically positive definite (rounding on a degenerate input) gets B
+  /// = (3 / trace) I if its trace is positive, else 0.
+  static InverseFactor3f of_inverse(const Eigen::Matrix3d& block) {
+    const Eigen::LLT<Eigen::Matrix3d> llt(block);
+    if (llt.info() != Eigen::Success || !(llt.matrixLLT().diagonal().minCoeff() > 0)) {
+      const double trace = block.trace();
+      return scalar(trace > 0 ? 3.0 / trace : 0.0);
+    }
+    const Eigen::Matrix3d M = llt.matrixL().solve(Eigen::Matrix3d::Identity());  // lower triangular, as L^-1 is
+    InverseFactor3f f;
+    f.m00 = static_cast<float>(M(0, 0)), f.m10 = static_cast<float>(M(1, 0)), f.m11 = static_cast<float>(M(1, 1));
+    f.m20 = static_cast<float>(M(2, 0)), f.m21 = static_cast<float>(M(2, 1)), f.m22 = static_cast<float>(M(2, 2));
+    return f;
+  }
+  /// B = scale I, scale >= 0.
+  static InverseFactor3f scalar(double scale) {
+    InverseFactor3f f;
+    f.m00 = f.m11 = f.m22 = static_cast<float>(std::sqrt(scale));
+    return f;
+  }
+
+  /// B r = M^T (M r).
+  [[nodiscard]] Eigen::Vector3d operator*(const Eigen::Vector3d& r) const {
+    const double a = m00, b = m10, c = m11, d = m20, e = m21, f = m22;
+    const double u = a * r.x(), v = b * r.x() + c * r.y(), w = d * r.x() + e * r.y() + f * r.z();
+    return {a * u + b * v + d * w, c * v + e * w, f * w};
+  }
+};
 
 /// Sym3f blocks of consecutive indices stored four at a time, each entry's four values side by
 /// side (xx of blocks 4g..4g+3, then their xy, ...): the same 24 bytes per block, but a pass

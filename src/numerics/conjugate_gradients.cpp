@@ -9,8 +9,8 @@
 
 namespace vertexflow {
 
-ConjugateGradients::ConjugateGradients(BlockOperator& op, std::vector<Sym3> block_inverse, const BlockVector& b,
-                                       PreconditionerCorrection* correction)
+ConjugateGradients::ConjugateGradients(BlockOperator& op, std::vector<InverseFactor3f> block_inverse,
+                                       const BlockVector& b, PreconditionerCorrection* correction)
     : op_(op), correction_(nullptr), inverse_(std::move(block_inverse)), blocks_(static_cast<Index>(inverse_.size())) {
   d_.setZero(b.size());
   r_ = b;

@@ -26,7 +26,8 @@ class PreconditionedResidual {
   /// z as stored.
   explicit PreconditionedResidual(const BlockVector& z) : stored_(&z) {}
   /// z_i = inverse[i] r_i.
-  PreconditionedResidual(const std::vector<Sym3>& inverse, const BlockVector& r) : inverse_(&inverse), r_(&r) {}
+  PreconditionedResidual(const std::vector<InverseFactor3f>& inverse, const BlockVector& r)
+      : inverse_(&inverse), r_(&r) {}
 
   [[nodiscard]] Eigen::Vector3d operator()(Index i) const {
     return stored_ ? Eigen::Vector3d(block_at(*stored_, i))
@@ -35,7 +36,7 @@ class PreconditionedResidual {
 
  private:
   const BlockVector* stored_ = nullptr;
-  const std::vector<Sym3>* inverse_ = nullptr;
+  const std::vector<InverseFactor3f>* inverse_ = nullptr;
   const BlockVector* r_ = nullptr;
 };
 
@@ -73,7 +74,7 @@ class ConjugateGradients {
  public:
   /// `block_inverse[i]`: the inverse of H's diagonal block i, or zero where row i is held.
   /// `op`, `b` and `correction` must outlive the iteration.
-  ConjugateGradients(BlockOperator& op, std::vector<Sym3> block_inverse, const BlockVector& b,
+  ConjugateGradients(BlockOperator& op, std::vector<InverseFactor3f> block_inverse, const BlockVector& b,
                      PreconditionerCorrection* correction = nullptr);
 
   /// Continues for at most max_iterations, stopping when |r| <= tolerance |b|.
@@ -105,7 +106,7 @@ class ConjugateGradients {
   PreconditionerCorrection* correction_;  // null: block-Jacobi alone
   std::optional<double> pending_beta_;    // p = z + beta p, done by the next operator application
   std::vector<double> alphas_, betas_;    // of the iterations since the last preconditioner change
-  std::vector<Sym3> inverse_;
+  std::vector<InverseFactor3f> inverse_;
   Index blocks_ = 0;
   BlockVector d_, r_, p_;
   // H p during an iteration's product, and z = M r from the update until the next product's

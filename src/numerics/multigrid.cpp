@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
+#include <optional>
 #include <stdexcept>
 #include <utility>
 
@@ -54,9 +55,9 @@ constexpr int kTransposeChunks = 4;
 // rows. The chunks count their blocks per column, and then each writes its own from its own
 // offsets, in parallel: this transpose on one core was 1.5 s of the hierarchy's set-up at 10M
 // vertices, with the page faults of first writing the result (docs/benchmarks.md).
-template <class Keep>
-void scatter_transposed(const BlockSparseMatrix& A, Keep&& keep, const std::vector<int>& first,
-                        std::vector<int>& column, std::vector<Matrix3>& block) {
+template <class Scalar, class Keep>
+void scatter_transposed(const BasicBlockSparseMatrix<Scalar>& A, Keep&& keep, const std::vector<int>& first,
+                        std::vector<int>& column, std::vector<Eigen::Matrix<Scalar, 3, 3>>& block) {
   const int chunk_rows = (A.rows + kTransposeChunks - 1) / kTransposeChunks;
   std::vector<std::vector<int>> place(kTransposeChunks);
   auto for_each_kept = [&](int chunk, auto&& visit) {
@@ -84,8 +85,9 @@ void scatter_transposed(const BlockSparseMatrix& A, Keep&& keep, const std::vect
   });
 }
 
-BlockSparseMatrix transpose(const BlockSparseMatrix& A) {
-  BlockSparseMatrix T;
+template <class Scalar>
+BasicBlockSparseMatrix<Scalar> transpose(const BasicBlockSparseMatrix<Scalar>& A) {
+  BasicBlockSparseMatrix<Scalar> T;
   T.rows = A.cols;
   T.cols = A.rows;
   T.start.assign(static_cast<std::size_t>(T.rows) + 1, 0);
@@ -98,45 +100,107 @@ BlockSparseMatrix transpose(const BlockSparseMatrix& A) {
   return T;
 }
 
+// The set-up reads a symmetric matrix by rows, either stored whole (BlockSparseMatrix) or as
+// its upper half (UpperHalf): for_each_in_row(A, k, visit) calls visit(column, block) for the
+// blocks of row k in column order, with the same values either way, so that a level built from
+// the upper half is the same bytes as one built from the whole matrix.
+template <class Visit>
+void for_each_in_row(const BlockSparseMatrix& A, int k, Visit&& visit) {
+  for (int m = A.start[static_cast<std::size_t>(k)]; m < A.start[static_cast<std::size_t>(k) + 1]; ++m)
+    visit(A.column[static_cast<std::size_t>(m)], A.block[static_cast<std::size_t>(m)]);
+}
+
+// A symmetric matrix from its upper half (diagonal included) and, for each row k, the places of
+// the upper half's blocks (r, k), r < k, in order of r: row k's strictly lower blocks are their
+// transposes. 8 bytes per such block, where the whole matrix would take another 72 + 4: the
+// whole first coarse matrix was the flow's peak memory on large meshes (docs/benchmarks.md).
+struct UpperHalf {
+  explicit UpperHalf(const BlockSparseMatrix& upper_half) : upper(upper_half), rows(upper.rows), cols(upper.cols) {
+    const auto n = static_cast<std::size_t>(rows);
+    lower_start.assign(n + 1, 0);
+    for (std::size_t r = 0; r < n; ++r)
+      for (int m = upper.start[r]; m < upper.start[r + 1]; ++m)
+        if (upper.column[static_cast<std::size_t>(m)] != static_cast<int>(r))
+          ++lower_start[static_cast<std::size_t>(upper.column[static_cast<std::size_t>(m)]) + 1];
+    std::partial_sum(lower_start.begin(), lower_start.end(), lower_start.begin());
+    lower.resize(static_cast<std::size_t>(lower_start.back()));
+    std::vector<int> next(lower_start.begin(), lower_start.end() - 1);
+    for (std::size_t r = 0; r < n; ++r)
+      for (int m = upper.start[r]; m < upper.start[r + 1]; ++m) {
+        const int c = upper.column[static_cast<std::size_t>(m)];
+        if (c != static_cast<int>(r))
+          lower[static_cast<std::size_t>(next[static_cast<std::size_t>(c)]++)] = {static_cast<int>(r), m};
+      }
+  }
+  const BlockSparseMatrix& upper;
+  int rows, cols;
+  std::vector<int> lower_start;
+  std::vector<std::pair<int, int>> lower;  // (row r, place of block (r, k) in upper)
+};
+
+template <class Visit>
+void for_each_in_row(const UpperHalf& A, int k, Visit&& visit) {
+  const auto row = static_cast<std::size_t>(k);
+  for (int p = A.lower_start[row]; p < A.lower_start[row + 1]; ++p) {
+    const auto [r, m] = A.lower[static_cast<std::size_t>(p)];
+    const Matrix3 block = A.upper.block[static_cast<std::size_t>(m)].transpose();
+    visit(r, block);
+  }
+  for_each_in_row(A.upper, k, visit);
+}
+
+// y = A x, as BlockSparseMatrix::multiply sums it.
+template <class Rows>
+void multiply(const Rows& A, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
+  y.resize(3 * static_cast<Eigen::Index>(A.rows));
+  parallel_rows(A.rows, [&](int k) {
+    Vector3 sum = Vector3::Zero();
+    for_each_in_row(A, k, [&](int column, const Matrix3& block) { sum.noalias() += block * block_at(x, column); });
+    block_at(y, k) = sum;
+  });
+}
+
 // The strong-connection graph of A's blocks, CSR.
-void strength_graph(const BlockSparseMatrix& A, std::vector<int>& start, std::vector<int>& neighbours) {
+template <class Rows>
+void strength_graph(const Rows& A, std::vector<int>& start, std::vector<int>& neighbours) {
   std::vector<double> diagonal(static_cast<std::size_t>(A.rows), 0.0);
   for (int k = 0; k < A.rows; ++k)
-    for (int m = A.start[static_cast<std::size_t>(k)]; m < A.start[static_cast<std::size_t>(k) + 1]; ++m)
-      if (A.column[static_cast<std::size_t>(m)] == k)
-        diagonal[static_cast<std::size_t>(k)] = A.block[static_cast<std::size_t>(m)].norm();
+    for_each_in_row(A, k, [&](int column, const Matrix3& block) {
+      if (column == k) diagonal[static_cast<std::size_t>(k)] = block.norm();
+    });
   start.assign(static_cast<std::size_t>(A.rows) + 1, 0);
   neighbours.clear();
   for (int k = 0; k < A.rows; ++k) {
-    for (int m = A.start[static_cast<std::size_t>(k)]; m < A.start[static_cast<std::size_t>(k) + 1]; ++m) {
-      const int l = A.column[static_cast<std::size_t>(m)];
-      if (l == k) continue;
+    for_each_in_row(A, k, [&](int l, const Matrix3& block) {
+      if (l == k) return;
       const double bound = kStrengthThreshold * kStrengthThreshold * diagonal[static_cast<std::size_t>(k)] *
                            diagonal[static_cast<std::size_t>(l)];
-      if (A.block[static_cast<std::size_t>(m)].squaredNorm() >= bound) neighbours.push_back(l);
-    }
+      if (block.squaredNorm() >= bound) neighbours.push_back(l);
+    });
     start[static_cast<std::size_t>(k) + 1] = static_cast<int>(neighbours.size());
   }
 }
 
-std::vector<Matrix3> block_diagonal_inverse(const BlockSparseMatrix& A) {
+template <class Rows>
+std::vector<Matrix3> block_diagonal_inverse(const Rows& A) {
   std::vector<Matrix3> inverse(static_cast<std::size_t>(A.rows), Matrix3::Zero());
   parallel_rows(A.rows, [&](int k) {
-    for (int m = A.start[static_cast<std::size_t>(k)]; m < A.start[static_cast<std::size_t>(k) + 1]; ++m)
-      if (A.column[static_cast<std::size_t>(m)] == k)
-        inverse[static_cast<std::size_t>(k)] = A.block[static_cast<std::size_t>(m)].inverse();
+    for_each_in_row(A, k, [&](int column, const Matrix3& block) {
+      if (column == k) inverse[static_cast<std::size_t>(k)] = block.inverse();
+    });
   });
   return inverse;
 }
 
 // Largest eigenvalue of B A (similar to a symmetric matrix), by power iteration from a fixed
 // start.
-double spectral_radius(const std::vector<Matrix3>& inverse_diagonal, const BlockSparseMatrix& A) {
+template <class Rows>
+double spectral_radius(const std::vector<Matrix3>& inverse_diagonal, const Rows& A) {
   Eigen::VectorXd v(3 * static_cast<Eigen::Index>(A.rows)), w;
   for (Eigen::Index k = 0; k < v.size(); ++k) v[k] = 1.0 + 0.5 * std::sin(0.7 * static_cast<double>(k));
   double lambda = 1;
   for (int iteration = 0; iteration < kPowerIterations; ++iteration) {
-    A.multiply(v, w);
+    multiply(A, v, w);
     for (int k = 0; k < A.rows; ++k) block_at(w, k) = inverse_diagonal[static_cast<std::size_t>(k)] * block_at(w, k);
     lambda = w.norm() / v.norm();
     v = w / w.norm();
@@ -144,11 +208,10 @@ double spectral_radius(const std::vector<Matrix3>& inverse_diagonal, const Block
   return lambda;
 }
 
-}  // namespace
-
-BlockSparseMatrix smoothed_prolongator(const BlockSparseMatrix& A, const std::vector<int>& aggregate, int count,
-                                       const std::vector<Eigen::Matrix3d>& block_inverse, double omega,
-                                       double truncation) {
+template <class Rows>
+BlockSparseMatrix smoothed_prolongator_of(const Rows& A, const std::vector<int>& aggregate, int count,
+                                          const std::vector<Eigen::Matrix3d>& block_inverse, double omega,
+                                          double truncation) {
   // Unit-length columns: phi_a = I / sqrt(|a|) on each node of aggregate a.
   std::vector<double> scale(static_cast<std::size_t>(count), 0.0);
   for (const int a : aggregate) scale[static_cast<std::size_t>(a)] += 1;
@@ -166,10 +229,10 @@ BlockSparseMatrix smoothed_prolongator(const BlockSparseMatrix& A, const std::ve
     const auto own = aggregate[static_cast<std::size_t>(k)];
     at(own).diagonal().array() += scale[static_cast<std::size_t>(own)];
     const Matrix3 damped = omega * block_inverse[static_cast<std::size_t>(k)];
-    for (int m = A.start[static_cast<std::size_t>(k)]; m < A.start[static_cast<std::size_t>(k) + 1]; ++m) {
-      const auto b = aggregate[static_cast<std::size_t>(A.column[static_cast<std::size_t>(m)])];
-      at(b).noalias() -= scale[static_cast<std::size_t>(b)] * (damped * A.block[static_cast<std::size_t>(m)]);
-    }
+    for_each_in_row(A, k, [&](int column, const Matrix3& block) {
+      const auto b = aggregate[static_cast<std::size_t>(column)];
+      at(b).noalias() -= scale[static_cast<std::size_t>(b)] * (damped * block);
+    });
     double largest = 0;
     for (const auto& entry : blocks) largest = std::max(largest, entry.second.norm());
     // The coarse translation is t / scale_b at aggregate b, on which a dropped block B acted as
@@ -184,6 +247,14 @@ BlockSparseMatrix smoothed_prolongator(const BlockSparseMatrix& A, const std::ve
     }
     row[own] += lumped;
   });
+}
+
+}  // namespace
+
+BlockSparseMatrix smoothed_prolongator(const BlockSparseMatrix& A, const std::vector<int>& aggregate, int count,
+                                       const std::vector<Eigen::Matrix3d>& block_inverse, double omega,
+                                       double truncation) {
+  return smoothed_prolongator_of(A, aggregate, count, block_inverse, omega, truncation);
 }
 
 BlockRowAccumulator::BlockRowAccumulator(int cols) : position_(static_cast<std::size_t>(cols), -1) {}
@@ -333,14 +404,31 @@ BlockSparseMatrix symmetric_from_upper(const BlockSparseMatrix& upper) {
   return S;
 }
 
-void BlockSparseMatrix::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
+template <class Scalar>
+void BasicBlockSparseMatrix<Scalar>::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
   y.resize(3 * static_cast<Eigen::Index>(rows));
   parallel_rows(rows, [&](int k) {
     Vector3 sum = Vector3::Zero();
     for (int m = start[static_cast<std::size_t>(k)]; m < start[static_cast<std::size_t>(k) + 1]; ++m)
-      sum.noalias() += block[static_cast<std::size_t>(m)] * block_at(x, column[static_cast<std::size_t>(m)]);
+      sum.noalias() +=
+          block[static_cast<std::size_t>(m)].template cast<double>() * block_at(x, column[static_cast<std::size_t>(m)]);
     block_at(y, k) = sum;
   });
+}
+template struct BasicBlockSparseMatrix<double>;
+template struct BasicBlockSparseMatrix<float>;
+
+FloatBlockSparseMatrix rounded_to_float(const BlockSparseMatrix& A) {
+  FloatBlockSparseMatrix F;
+  F.rows = A.rows;
+  F.cols = A.cols;
+  F.start = A.start;
+  F.column = A.column;
+  F.block.resize(A.block.size());
+  parallel_rows(static_cast<int>(A.block.size()), [&](int m) {
+    F.block[static_cast<std::size_t>(m)] = A.block[static_cast<std::size_t>(m)].cast<float>();
+  });
+  return F;
 }
 
 std::vector<int> aggregate_nodes(const std::vector<int>& start, const std::vector<int>& neighbours,
@@ -400,7 +488,9 @@ namespace {
 // needs only: A P whole was as large as A, and beside A, P and R the peak of the hierarchy's
 // set-up. Each row of A P and each block of the product is summed in the order of the whole
 // product, so the result is the same.
-BlockSparseMatrix galerkin_product(const BlockSparseMatrix& A, const BlockSparseMatrix& P, const BlockSparseMatrix& R) {
+template <class Rows, class Scalar>
+BlockSparseMatrix galerkin_product(const Rows& A, const BasicBlockSparseMatrix<Scalar>& P,
+                                   const BasicBlockSparseMatrix<Scalar>& R) {
   std::vector<int> slot(static_cast<std::size_t>(A.rows), -1);  // row of A P -> its row in `ap`
   std::vector<int> needed;
   std::vector<RowChunk> ap;  // the rows `needed` of A P, kRowsPerChunk to a chunk
@@ -419,13 +509,11 @@ BlockSparseMatrix galerkin_product(const BlockSparseMatrix& A, const BlockSparse
     build_row_chunks(
         static_cast<int>(needed.size()),
         [&](int t, BlockRowAccumulator& row) {
-          const auto k = static_cast<std::size_t>(needed[static_cast<std::size_t>(t)]);
-          for (int m = A.start[k]; m < A.start[k + 1]; ++m) {
-            const int l = A.column[static_cast<std::size_t>(m)];
-            const Matrix3& a = A.block[static_cast<std::size_t>(m)];
+          for_each_in_row(A, needed[static_cast<std::size_t>(t)], [&](int l, const Matrix3& a) {
             for (int q = P.start[static_cast<std::size_t>(l)]; q < P.start[static_cast<std::size_t>(l) + 1]; ++q)
-              row[P.column[static_cast<std::size_t>(q)]].noalias() += a * P.block[static_cast<std::size_t>(q)];
-          }
+              row[P.column[static_cast<std::size_t>(q)]].noalias() +=
+                  a * P.block[static_cast<std::size_t>(q)].template cast<double>();
+          });
         },
         accumulators, ap);
   };
@@ -433,7 +521,7 @@ BlockSparseMatrix galerkin_product(const BlockSparseMatrix& A, const BlockSparse
       R.rows, P.cols,
       [&](int i, BlockRowAccumulator& row) {
         for (int m = R.start[static_cast<std::size_t>(i)]; m < R.start[static_cast<std::size_t>(i) + 1]; ++m) {
-          const Matrix3& left = R.block[static_cast<std::size_t>(m)];
+          const Matrix3 left = R.block[static_cast<std::size_t>(m)].template cast<double>();
           const auto t =
               static_cast<std::size_t>(slot[static_cast<std::size_t>(R.column[static_cast<std::size_t>(m)])]);
           const RowChunk& chunk = ap[t / kRowsPerChunk];
@@ -445,30 +533,56 @@ BlockSparseMatrix galerkin_product(const BlockSparseMatrix& A, const BlockSparse
       8192, prepare);
 }
 
-}  // namespace
+// The next level of a hierarchy: aggregates of A's strongly connected nodes, the smoothed and
+// truncated prolongator P (rounded to float), R = P^T and the Galerkin matrix R A P of the
+// rounded P; none when coarsening stalls.
+struct CoarseLevel {
+  std::vector<Matrix3> block_inverse;  // of A
+  FloatBlockSparseMatrix P, R;
+  BlockSparseMatrix A;  // R A P
+};
 
-AdditiveMultilevel::AdditiveMultilevel(BlockSparseMatrix A, int coarsest_unknowns) {
-  if (A.rows != A.cols || A.start.size() != static_cast<std::size_t>(A.rows) + 1)
-    throw std::invalid_argument("multilevel: the matrix must be square");
-  while (3 * A.rows > coarsest_unknowns) {
+template <class Rows>
+std::optional<CoarseLevel> coarsen(const Rows& A) {
+  CoarseLevel level;
+  int count = 0;
+  {
     std::vector<int> start, neighbours;
     strength_graph(A, start, neighbours);
-    int count = 0;
     const std::vector<int> aggregate =
         aggregate_nodes(start, neighbours, std::vector<char>(static_cast<std::size_t>(A.rows), 0), count);
-    if (count == 0 || count > 0.8 * A.rows) break;  // coarsening stalled
+    if (count == 0 || count > 0.8 * A.rows) return std::nullopt;  // coarsening stalled
     // The tentative prolongator (the translations of each aggregate) smoothed by one damped
     // block-Jacobi step, omega = 4 / (3 rho(B A)), the usual damping (it minimises the
     // prolongator's energy for the highest modes), and truncated (kProlongatorTruncation).
-    Level level;
     level.block_inverse = block_diagonal_inverse(A);
     const double omega = 4.0 / (3.0 * spectral_radius(level.block_inverse, A));
-    level.P = smoothed_prolongator(A, aggregate, count, level.block_inverse, omega, kProlongatorTruncation);
-    level.R = transpose(level.P);
-    BlockSparseMatrix coarse = galerkin_product(A, level.P, level.R);
-    levels_.push_back(std::move(level));
-    A = std::move(coarse);
+    level.P = rounded_to_float(
+        smoothed_prolongator_of(A, aggregate, count, level.block_inverse, omega, kProlongatorTruncation));
   }
+  level.R = transpose(level.P);
+  level.A = galerkin_product(A, level.P, level.R);
+  return level;
+}
+
+}  // namespace
+
+AdditiveMultilevel::AdditiveMultilevel(BlockSparseMatrix A, Storage storage, int coarsest_unknowns) {
+  if (A.rows != A.cols || A.start.size() != static_cast<std::size_t>(A.rows) + 1)
+    throw std::invalid_argument("multilevel: the matrix must be square");
+  auto add_level = [&](std::optional<CoarseLevel> next) {
+    if (!next) return false;
+    levels_.push_back(Level{std::move(next->block_inverse), std::move(next->P), std::move(next->R)});
+    A = std::move(next->A);
+    return true;
+  };
+  bool stalled = false;
+  if (storage == Storage::UpperHalf) {
+    // The first level from the upper half; the coarser ones, an eighth as large, whole.
+    if (3 * A.rows > coarsest_unknowns) stalled = !add_level(coarsen(UpperHalf(A)));
+    if (levels_.empty()) A = symmetric_from_upper(A);
+  }
+  while (!stalled && 3 * A.rows > coarsest_unknowns) stalled = !add_level(coarsen(A));
   coarsest_unknowns_ = 3 * static_cast<Eigen::Index>(A.rows);
   if (coarsest_unknowns_ > std::max<Eigen::Index>(coarsest_unknowns, kLargestDenseCoarsest)) {
     // Coarsening stalled on a large level: most of its nodes have no strong neighbour (many

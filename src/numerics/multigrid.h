@@ -23,17 +23,26 @@
 
 namespace vertexflow {
 
-/// A square sparse matrix of 3x3 blocks in compressed rows: row k holds the blocks
-/// (k, column[m]) for m in [start[k], start[k+1]), columns increasing.
-struct BlockSparseMatrix {
+/// A sparse matrix of 3x3 blocks in compressed rows: row k holds the blocks (k, column[m]) for
+/// m in [start[k], start[k+1]), columns increasing. Blocks of double (BlockSparseMatrix), or
+/// of float for matrices that are only applied (FloatBlockSparseMatrix).
+template <class Scalar>
+struct BasicBlockSparseMatrix {
   int rows = 0, cols = 0;  // in blocks
   std::vector<int> start{0};
   std::vector<int> column;
-  std::vector<Eigen::Matrix3d> block;
+  std::vector<Eigen::Matrix<Scalar, 3, 3>> block;
 
-  /// y = A x (3 entries per block row / column).
+  /// y = A x (3 entries per block row / column), in double whatever the blocks' type.
   void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;
 };
+using BlockSparseMatrix = BasicBlockSparseMatrix<double>;
+/// Half the bytes of a BlockSparseMatrix: the multilevel operator's prolongations and
+/// restrictions, read at every application and kept through the whole iteration.
+using FloatBlockSparseMatrix = BasicBlockSparseMatrix<float>;
+
+/// A's blocks rounded to float.
+FloatBlockSparseMatrix rounded_to_float(const BlockSparseMatrix& A);
 
 /// The blocks of one row under construction, keyed by column (a sparse accumulator):
 /// row[column] is the block, zero when first touched.
@@ -91,10 +100,17 @@ BlockSparseMatrix smoothed_prolongator(const BlockSparseMatrix& A, const std::ve
 /// gradients. Deterministic, and the same for any thread count.
 class AdditiveMultilevel {
  public:
-  /// A: symmetric positive definite, both halves stored. Coarsens until at most
-  /// `coarsest_unknowns` unknowns remain or coarsening stalls. Throws std::runtime_error if the
-  /// coarsest matrix is not numerically positive definite.
-  explicit AdditiveMultilevel(BlockSparseMatrix A, int coarsest_unknowns = 240);
+  /// How the matrix given to the constructor is stored.
+  enum class Storage {
+    Whole,      ///< both halves
+    UpperHalf,  ///< its upper half, diagonal included, and no block below the diagonal
+  };
+
+  /// A: symmetric positive definite, stored as `storage` says (the upper half saves the lower
+  /// half's copy, the set-up's largest matrix; the hierarchy is the same bytes either way).
+  /// Coarsens until at most `coarsest_unknowns` unknowns remain or coarsening stalls. Throws
+  /// std::runtime_error if the coarsest matrix is not numerically positive definite.
+  explicit AdditiveMultilevel(BlockSparseMatrix A, Storage storage = Storage::Whole, int coarsest_unknowns = 240);
 
   /// x = M b.
   void apply(const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
@@ -105,10 +121,12 @@ class AdditiveMultilevel {
   [[nodiscard]] bool coarsest_factored() const { return coarsest_block_inverse_.empty(); }
 
  private:
+  // P and R in float: a preconditioner needs only to be symmetric positive definite, which
+  // R = P^T of the same rounded blocks keeps; they were most of the hierarchy's bytes.
   struct Level {
     std::vector<Eigen::Matrix3d> block_inverse;  // B_l
-    BlockSparseMatrix P;                         // prolongation from the next level
-    BlockSparseMatrix R;                         // P^T
+    FloatBlockSparseMatrix P;                    // prolongation from the next level
+    FloatBlockSparseMatrix R;                    // P^T
   };
   void apply(std::size_t level, const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
 

@@ -1,9 +1,11 @@
 // The smoothed-aggregation pieces behind LinearSolver::Multilevel (src/flow/multigrid.h):
 // aggregation of a graph, and the additive multilevel operator as a preconditioner of a
 // bi-Laplacian, the operator whose slow modes it exists for.
+#include "numerics/block3.h"
 #include "numerics/multigrid.h"
 
 #include <gtest/gtest.h>
+#include <Eigen/QR>
 #include <Eigen/Sparse>
 
 #include <algorithm>
@@ -160,6 +162,75 @@ TEST(Multigrid, AdditiveMultilevelIsASymmetricPositivePreconditioner) {
   EXPECT_GT(v.dot(Mv), 0);
 }
 
+// D^T A D for a block diagonal D of random, well-conditioned 3x3 blocks: still symmetric positive
+// definite, but its off-diagonal blocks D_k^T A_kl D_l are not symmetric, so that a lower block
+// read without its transpose would show.
+BlockSparseMatrix congruent(const BlockSparseMatrix& A, unsigned seed) {
+  std::mt19937 random(seed);
+  std::uniform_real_distribution<double> entry(-0.3, 0.3);
+  std::vector<Eigen::Matrix3d> D(static_cast<std::size_t>(A.rows));
+  for (Eigen::Matrix3d& d : D)
+    d = Eigen::Matrix3d::Identity() + Eigen::Matrix3d::NullaryExpr([&] { return entry(random); });
+  BlockSparseMatrix C = A;
+  for (int k = 0; k < A.rows; ++k)
+    for (int m = A.start[static_cast<std::size_t>(k)]; m < A.start[static_cast<std::size_t>(k) + 1]; ++m)
+      C.block[static_cast<std::size_t>(m)] = D[static_cast<std::size_t>(k)].transpose() *
+                                             A.block[static_cast<std::size_t>(m)] *
+                                             D[static_cast<std::size_t>(A.column[static_cast<std::size_t>(m)])];
+  return C;
+}
+
+BlockSparseMatrix upper_half(const BlockSparseMatrix& A) {
+  BlockSparseMatrix U;
+  U.rows = U.cols = A.rows;
+  for (int k = 0; k < A.rows; ++k) {
+    for (int m = A.start[static_cast<std::size_t>(k)]; m < A.start[static_cast<std::size_t>(k) + 1]; ++m)
+      if (A.column[static_cast<std::size_t>(m)] >= k) {
+        U.column.push_back(A.column[static_cast<std::size_t>(m)]);
+        U.block.push_back(A.block[static_cast<std::size_t>(m)]);
+      }
+    U.start.push_back(static_cast<int>(U.column.size()));
+  }
+  return U;
+}
+
+TEST(Multigrid, TheUpperHalfGivesTheSameHierarchy) {
+  // The flow hands its first coarse matrix over as its upper half (the set-up's largest matrix,
+  // not copied whole). The hierarchy must be the same bytes: M u equal to the last bit, for a
+  // matrix that coarsens over several levels, one already at the coarsest size, and one whose
+  // coarsening stalls at once.
+  auto expect_same = [](const BlockSparseMatrix& A, int coarsest_unknowns) {
+    const AdditiveMultilevel whole(A, AdditiveMultilevel::Storage::Whole, coarsest_unknowns);
+    const AdditiveMultilevel upper(upper_half(A), AdditiveMultilevel::Storage::UpperHalf, coarsest_unknowns);
+    EXPECT_EQ(whole.num_levels(), upper.num_levels());
+    EXPECT_EQ(whole.coarsest_unknowns(), upper.coarsest_unknowns());
+    std::mt19937 random(3);
+    std::normal_distribution<double> normal;
+    Eigen::VectorXd u(3 * A.rows), Mu_whole, Mu_upper;
+    for (Eigen::Index k = 0; k < u.size(); ++k) u[k] = normal(random);
+    whole.apply(u, Mu_whole);
+    upper.apply(u, Mu_upper);
+    EXPECT_TRUE(Mu_whole == Mu_upper) << "largest difference " << (Mu_whole - Mu_upper).cwiseAbs().maxCoeff();
+  };
+  // Exactly symmetric (the congruence rounds its two halves differently): the upper half's.
+  const BlockSparseMatrix A = symmetric_from_upper(upper_half(congruent(bilaplacian(24, 1e-6), 5)));
+  expect_same(A, 240);
+  expect_same(A, 3 * A.rows);  // no coarse level: factored whole
+  BlockSparseMatrix diagonal;  // no strong connection: coarsening stalls on the first level
+  diagonal.rows = diagonal.cols = 600;
+  for (int k = 0; k < diagonal.rows; ++k) {
+    diagonal.column.push_back(k);
+    diagonal.block.push_back((1.0 + 0.1 * (k % 5)) * Eigen::Matrix3d::Identity());
+    diagonal.start.push_back(k + 1);
+  }
+  expect_same(diagonal, 240);
+  {
+    const AdditiveMultilevel M(upper_half(diagonal), AdditiveMultilevel::Storage::UpperHalf, 240);
+    EXPECT_EQ(M.num_levels(), 1);
+    EXPECT_FALSE(M.coarsest_factored());
+  }
+}
+
 TEST(Multigrid, CutsTheIterationsOfABiLaplacian) {
   // Block-Jacobi's count grows like the side squared on a bi-Laplacian; the multilevel
   // operator's grows much more slowly (measured here: 1,733 against 478 with the truncated
@@ -234,6 +305,44 @@ TEST(Multigrid, TruncatedProlongatorKeepsTheTranslations) {
 // first coarsening, the next level has no strong couplings and coarsening stalls with 30,000
 // nodes. A dense factor of that level would take 65 GB; the block-Jacobi inverse that replaces
 // it keeps M symmetric positive definite and, since the level is block diagonal, exact there.
+TEST(BlockJacobi, FloatFactorKeepsAnAnisotropicInversePositiveDefinite) {
+  // Block-Jacobi's inverses are stored as float factors, B = M^T M (block3.h). On blocks more
+  // anisotropic than the flow's (stiff along a normal n, soft in the tangent plane; 1e12 against
+  // 1, in random frames) n^T B n, the stiff direction's 1e-12, must stay positive and about
+  // right, where an entry-wise rounded inverse (Sym3f) errs by 1e-8 (measured 1.2e-8), four
+  // orders more. B r is the inverse's product to float accuracy at 1e6 against 1 (measured
+  // 4.8e-7; at 1e12 double's own Cholesky loses 1e-4 to cancellation).
+  std::mt19937 random(13);
+  std::normal_distribution<double> normal;
+  double worst_stiff = 1, worst_product = 0, worst_rounded = 0;
+  for (int trial = 0; trial < 200; ++trial) {
+    const Eigen::Matrix3d Q =
+        Eigen::Matrix3d::NullaryExpr([&] { return normal(random); }).householderQr().householderQ();
+    auto frame_block = [&](double stiff) {
+      const Eigen::Vector3d stiffness(stiff, 1.0 + 0.5 * (trial % 3), 1.0);
+      return std::pair{Eigen::Matrix3d(Q * stiffness.asDiagonal() * Q.transpose()),
+                       Eigen::Matrix3d(Q * stiffness.cwiseInverse().asDiagonal() * Q.transpose())};
+    };
+    const auto [block, inverse] = frame_block(1e12);
+    const InverseFactor3f B = InverseFactor3f::of_inverse(block);
+    const Eigen::Vector3d n = Q.col(0);
+    worst_stiff = std::min(worst_stiff, std::min(n.dot(B * n) / 1e-12, 1e-12 / n.dot(B * n)));
+    worst_rounded = std::max(worst_rounded, std::abs(n.dot(Sym3f(inverse) * n) - 1e-12));
+    const auto [moderate, moderate_inverse] = frame_block(1e6);
+    const Eigen::Vector3d r(normal(random), normal(random), normal(random));
+    worst_product = std::max(worst_product, (InverseFactor3f::of_inverse(moderate) * r - moderate_inverse * r).norm() /
+                                                (moderate_inverse * r).norm());
+  }
+  std::cout << "[measured] n^T B n within a factor " << 1 / worst_stiff << " of 1e-12; product error " << worst_product
+            << "; rounded inverse's n^T B n error " << worst_rounded << "\n";
+  EXPECT_GT(worst_stiff, 0.5);
+  EXPECT_LT(worst_product, 1.5e-6);
+  // The scalar form (the fit's block-Jacobi) and a block that is not positive definite.
+  EXPECT_TRUE((InverseFactor3f::scalar(0.25) * Eigen::Vector3d(4, 8, -4)).isApprox(Eigen::Vector3d(1, 2, -1), 1e-6));
+  const InverseFactor3f fallback = InverseFactor3f::of_inverse(Eigen::Vector3d(2.0, 1.0, -0.5).asDiagonal());
+  EXPECT_TRUE((fallback * Eigen::Vector3d(1, 1, 1)).isApprox(Eigen::Vector3d(1.2, 1.2, 1.2), 1e-6));  // 3 / trace
+}
+
 TEST(Multigrid, StalledCoarseningOnManyComponentsStaysLinear) {
   constexpr int kComponents = 30000, kPath = 4;
   BlockSparseMatrix A;
