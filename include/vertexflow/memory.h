@@ -23,14 +23,15 @@ class InsufficientMemoryError : public std::runtime_error {
 };
 
 /// The whole process's peak resident memory for `enhance` on a mesh of `vertices` (bytes): a
-/// fixed part plus bytes per vertex, both from the measured peaks of docs/benchmarks.md ("Fewer
-/// vectors through the solve"), rounded up, plus the reference's trees and curvature per
-/// reference vertex (`reference_vertices`, 0 for none). `solver` is the flow's
-/// (FlowOptions::solver): LinearSolver::Iterative never builds the multilevel hierarchy and
-/// peaks lower; the other choices are estimated by the multilevel path, which Automatic takes on
-/// large meshes (a forced Direct factorisation's fill is not modelled). The report's metrics
-/// peak below the flow, so `with_report` does not change the estimate (plan_memory_for_enhance
-/// names it in its message). Never throws.
+/// fixed part plus bytes per vertex, both from the measured peaks of docs/benchmarks.md ("Float
+/// storage in the solve, and the first coarse matrix by its upper half"), rounded up, plus the
+/// reference's trees and curvature per reference vertex (`reference_vertices`, 0 for none).
+/// `solver` is the flow's (FlowOptions::solver): LinearSolver::Iterative never builds the
+/// multilevel hierarchy and peaks a little lower; the other choices are estimated by the
+/// multilevel path, which Automatic takes on large meshes (a forced Direct factorisation's fill
+/// is not modelled). The estimates are of runs with a report, whose metrics peak about as high as
+/// the flow, so `with_report` does not change them (plan_memory_for_enhance names it in its
+/// message). Never throws.
 std::uint64_t estimated_enhance_peak_bytes(Index vertices, bool with_report, Index reference_vertices,
                                            LinearSolver solver = LinearSolver::Automatic);
 

@@ -14,19 +14,19 @@ namespace vertexflow {
 namespace {
 
 // Peak RSS = fixed part + bytes per vertex, fitted to the whole-process peaks measured at 1M and
-// 10M vertices (docs/benchmarks.md, "Fewer vectors through the solve") and rounded up. The
-// multilevel path: 1,013,896 KB at 1,081,027 vertices (arm1m, --solver multilevel) and
-// 8,349,316 KB at 9,729,227 (arm10m, the default, with --report), a slope of 868 B/vertex above
-// about 100 MB. Block-Jacobi alone (--solver iterative): 707,896 KB at 1M and 6,870,968 KB at
-// 10M with --report (there the report's metrics may be the peak), a slope of 730 B/vertex. The
-// report's metrics otherwise peak below the flow (843 against 1,014 MiB at 1M), so a report adds
-// nothing. A reference vertex costs its distance tree, curvature and copies. The CLI's jemalloc
-// with huge pages (apps/allocator.cpp) holds up to about 40 MB more on small meshes (a
-// 163,842-vertex sphere: 224.7 -> 265.7 MB with thp:always alone; at 1M within 15 MB either way,
-// at 10M 85 MB less): the fixed part was 128 MiB before it.
+// 10M vertices and rounded up (docs/benchmarks.md, "Float storage in the solve, and the first
+// coarse matrix by its upper half"). Above the fixed part: the multilevel path 609 B/vertex at
+// 1,081,027 vertices (arm1m, --solver multilevel, 823,164 KB) and 622 at 9,729,227 (arm10m, the
+// default, 6,088,980 KB), 635 and 627 with --report (850,848 and 6,140,620 KB); block-Jacobi
+// alone (--solver iterative) 456 at 1M (661,500 KB), and with --report, whose metrics are then
+// the peak, 605 at 1M (819,372 KB) and 624 at 10M (6,108,084 KB). With a report both paths peak
+// alike, so the estimates are of runs with one, block-Jacobi's a little lower; the fixed part
+// and a reference vertex's cost are as fitted before (the fixed part was 128 MiB before the
+// CLI's jemalloc, which holds up to about 40 MB more on small meshes: a 163,842-vertex sphere
+// 224.7 -> 265.7 MB with thp:always alone).
 constexpr double kFixedBytes = 176.0 * 1024 * 1024;
-constexpr double kBytesPerVertexMultilevel = 900;
-constexpr double kBytesPerVertexBlockJacobi = 750;
+constexpr double kBytesPerVertexMultilevel = 680;
+constexpr double kBytesPerVertexBlockJacobi = 650;
 constexpr double kReferenceBytesPerVertex = 900;
 
 // A "Key:   N kB" line of a /proc file, in bytes.
