@@ -149,7 +149,9 @@ void for_each_in_row(const UpperHalf& A, int k, Visit&& visit) {
   for_each_in_row(A.upper, k, visit);
 }
 
-// y = A x, as BlockSparseMatrix::multiply sums it.
+// y = A x, as BlockSparseMatrix::multiply sums it. Not folded with that member, which also
+// applies the hierarchy's float blocks: its product with the lazily cast block rounds
+// differently from one with a block first copied to double (the outputs' bytes would change).
 template <class Rows>
 void multiply(const Rows& A, const Eigen::VectorXd& x, Eigen::VectorXd& y) {
   y.resize(3 * static_cast<Eigen::Index>(A.rows));
