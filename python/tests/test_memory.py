@@ -13,8 +13,8 @@ import pytest
 
 from conftest import DATA
 
-# 2,250,000 vertices need about 1.7 GiB by the estimate even with block-Jacobi alone (128 MiB plus
-# 750 B per vertex; vertexflow/memory.h), far more than the headroom; sphere_low (589 vertices)
+# 2,250,000 vertices need about 1.5 GiB by the estimate even with block-Jacobi alone (176 MiB plus
+# 650 B per vertex; vertexflow/memory.h), far more than the headroom; sphere_low (589 vertices)
 # runs within it.
 HEADROOM_MB = 768
 
@@ -40,10 +40,10 @@ if mesh.startswith("grid"):
 else:
     V, F = vertexflow.read_mesh(mesh)
 if headroom == 0:
-    # Between the two paths' estimates (vertexflow/memory.h: 128 MiB plus 900 B per vertex with
-    # the multilevel preconditioner, 750 without), less what this process holds already.
-    estimate = lambda per_vertex: 128 * 2**20 + per_vertex * len(V)
-    headroom = (estimate(900) + estimate(750)) // 2 - status_bytes("VmRSS")
+    # Between the two paths' estimates (src/common/memory_estimate.cpp: 176 MiB plus 680 B per
+    # vertex with the multilevel preconditioner, 650 without), less what this process holds already.
+    estimate = lambda per_vertex: 176 * 2**20 + per_vertex * len(V)
+    headroom = (estimate(680) + estimate(650)) // 2 - status_bytes("VmRSS")
 limit = status_bytes("VmSize") + headroom
 resource.setrlimit(resource.RLIMIT_AS, (limit, resource.getrlimit(resource.RLIMIT_AS)[1]))
 try:
