@@ -171,13 +171,15 @@ struct FlowOptions {
   /// horse-48k; the iteration counts of bunny_uniform and the 1M-vertex armadillo): 1e-6 within
   /// 1.1e-3 / 1.9e-5 (65 and 142 iterations), 1e-5 within 3.8e-3 / 2.7e-4 (52 and 111), 1e-4
   /// within 3.7e-2 / 2.4e-3 (37 and 85; camelhead's largest, 0.11, is a vertex the guard halved
-  /// differently). The flow moves vertices by 0.1-3 mean edge lengths and projects them onto
-  /// the input afterwards, and every figure of bench/make_results.py stayed within 0.5% between
-  /// 1e-6 and 1e-4 (but a sliver's quality, 8.0e-5 against 7.4e-5, and a zero at rounding
-  /// level), while the solve is half or more of a large run: so 1e-4, 35-47% fewer iterations
-  /// than 1e-6. Ask for 1e-6 or less where the displacement itself must be exact to 1e-3 of an
-  /// edge (comparisons of solvers, tests of invariance); docs/benchmarks.md, "Solver tolerance
-  /// 1e-4".
+  /// differently; with the solve's float storage 3.4e-2 / 2.2e-3 and 83 on the armadillo,
+  /// docs/benchmarks.md, "Float storage in the solve"). From 1e-6 up, the iterations' products
+  /// keep the operator's caches in float (about 3e-8 of rounding each). The flow moves vertices
+  /// by 0.1-3 mean edge lengths and projects them onto the input afterwards, and every figure of
+  /// bench/make_results.py stayed within 0.5% between 1e-6 and 1e-4 (but a sliver's quality,
+  /// 8.0e-5 against 7.4e-5, and a zero at rounding level), while the solve is half or more of a
+  /// large run: so 1e-4, 35-47% fewer iterations than 1e-6. Ask for 1e-6 or less where the
+  /// displacement itself must be exact to 1e-3 of an edge (comparisons of solvers, tests of
+  /// invariance); docs/benchmarks.md, "Solver tolerance 1e-4".
   double solver_tolerance = 1e-4;
   /// Density-weighted centroidal passes after the solves (none by default; DensityRelaxation).
   DensityRelaxation density;
