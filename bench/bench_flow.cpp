@@ -148,8 +148,9 @@ void run(benchmark::State& state, const std::string& name, LinearSolver solver, 
 }
 
 // The solve's operator on `name`'s first frame (as FlowSystemSolver numbers the vertices),
-// applied to the normalised right-hand side.
-void run_operator(benchmark::State& state, const std::string& name) {
+// applied to the normalised right-hand side, with its caches in `precision` (the iterations'
+// products use Float at the default tolerance: flow_operator.h).
+void run_operator(benchmark::State& state, const std::string& name, FlowOperator::CachePrecision precision) {
   const Mesh& input = mesh(name);
   const Topology topology = build_topology(input.F, input.num_vertices());
   const FlowOptions options;
@@ -160,6 +161,7 @@ void run_operator(benchmark::State& state, const std::string& name) {
   FlowOperator op(terms);
   const BlockVector b = op.right_hand_side(to_local(terms, frame.P.data()));
   const BlockVector x = b / b.norm();
+  op.use_cache_precision(precision);
   BlockVector y(x.size());
   op.apply(x, y);  // the caches' first touch outside the loop
   for (auto _ : state) benchmark::DoNotOptimize(op.apply(x, y));
@@ -169,10 +171,12 @@ void run_operator(benchmark::State& state, const std::string& name) {
 
 void register_cases() {
   for (const std::string name : {"bunny_uniform.off", "amo.off", "armadillo-1M"})
-    benchmark::RegisterBenchmark(("operator/" + name).c_str(),
-                                 [name](benchmark::State& state) { run_operator(state, name); })
-        ->Unit(benchmark::kMillisecond)
-        ->UseRealTime();
+    for (const auto& [suffix, precision] : {std::pair{"", FlowOperator::CachePrecision::Double},
+                                            std::pair{"/float", FlowOperator::CachePrecision::Float}})
+      benchmark::RegisterBenchmark(("operator/" + name + suffix).c_str(),
+                                   [name, precision](benchmark::State& state) { run_operator(state, name, precision); })
+          ->Unit(benchmark::kMillisecond)
+          ->UseRealTime();
   // Table 1's meshes (torus, Max-Planck, spot, fandisk, horse at ~10k, bunny, armadillo), amo
   // (90k) as the ~100k case, the subdivided armadillo as the ~1M case.
   const std::vector<std::string> table = {"torus.obj",         "max-planck-5k.obj", "spot.obj",

@@ -173,7 +173,7 @@ struct FlowOptions {
   /// within 3.7e-2 / 2.4e-3 (37 and 85; camelhead's largest, 0.11, is a vertex the guard halved
   /// differently; with the solve's float storage 3.4e-2 / 2.2e-3 and 83 on the armadillo,
   /// docs/benchmarks.md, "Float storage in the solve"). From 1e-6 up, the iterations' products
-  /// keep the operator's caches in float (about 3e-8 of rounding each). The flow moves vertices
+  /// keep the operator's caches in float (about 5e-8 of rounding each). The flow moves vertices
   /// by 0.1-3 mean edge lengths and projects them onto the input afterwards, and every figure of
   /// bench/make_results.py stayed within 0.5% between 1e-6 and 1e-4 (but a sliver's quality,
   /// 8.0e-5 against 7.4e-5, and a zero at rounding level), while the solve is half or more of a

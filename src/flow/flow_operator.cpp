@@ -114,14 +114,14 @@ template <class Cache>
   for (int l = 0; l < count; ++l) {
     const Index i = first + l;
     const auto [begin, end] = t.one_ring(i);
-    Eigen::Vector3d sx = Eigen::Vector3d::Zero(), skx = Eigen::Vector3d::Zero();
+    Eigen::Vector3d sx = Eigen::Vector3d::Zero();
+    Eigen::Matrix<Cache, 3, 1> skx = Eigen::Matrix<Cache, 3, 1>::Zero();  // summed as stored
     for (const Index* j = begin; j != end; ++j) {
       sx += Eigen::Map<const Eigen::Vector3d>(d.x + 3 * static_cast<std::ptrdiff_t>(*j));
-      skx += Eigen::Map<const Eigen::Matrix<Cache, 3, 1>>(d.kx + 3 * static_cast<std::ptrdiff_t>(*j))
-                 .template cast<double>();
+      skx += Eigen::Map<const Eigen::Matrix<Cache, 3, 1>>(d.kx + 3 * static_cast<std::ptrdiff_t>(*j));
     }
     put(sum_x, l, sx);
-    put(sum_kx, l, skx);
+    put(sum_kx, l, skx.template cast<double>());
     put(own_x, l, Eigen::Map<const Eigen::Vector3d>(d.x + 3 * static_cast<std::ptrdiff_t>(i)));
     if (with_rest) put(rest, l, t.rest[static_cast<std::size_t>(i)]);
     inv_degree[l] = t.inv_degree[static_cast<std::size_t>(i)];
@@ -175,10 +175,10 @@ template <class Cache>
     for (int l = 0; l < count; ++l) {
       const Index u = first + l;
       const auto [begin, end] = t.one_ring(u);
-      Eigen::Matrix<double, 9, 1> sum = Eigen::Matrix<double, 9, 1>::Zero();
+      Eigen::Matrix<Cache, 9, 1> records = Eigen::Matrix<Cache, 9, 1>::Zero();  // summed as stored
       for (const Index* j = begin; j != end; ++j)
-        sum += Eigen::Map<const Eigen::Matrix<Cache, 9, 1>>(d.qkr + 9 * static_cast<std::ptrdiff_t>(*j))
-                   .template cast<double>();
+        records += Eigen::Map<const Eigen::Matrix<Cache, 9, 1>>(d.qkr + 9 * static_cast<std::ptrdiff_t>(*j));
+      const Eigen::Matrix<double, 9, 1> sum = records.template cast<double>();
       put(sum_q, l, sum.head<3>());
       put(sum_kq, l, sum.segment<3>(3));
       put(sum_r, l, sum.tail<3>());

@@ -20,10 +20,13 @@ class FlowOperator : public BlockOperator {
  public:
   /// How the passes keep K x and (q, K q, r) between them. Double: H x exactly as the factors
   /// define it (to double rounding). Float: 48 bytes per vertex instead of 96, part of the
-  /// solve's peak memory, at the same speed (the passes are bound by arithmetic); each product
-  /// then carries a rounding of about 3e-8 relative (the residual of an exact solution measured
-  /// through it: 2e-8 to 8e-8 on the data meshes), so it serves iterations stopped well above
-  /// that (FlowSystemSolver's iterations at tolerances of 1e-6 and more).
+  /// solve's peak memory, and the neighbours' records summed in float before one conversion
+  /// (the passes are bound by arithmetic: a product on the 1M armadillo takes 25.0 ms against
+  /// 29.9 ms, bench_flow's operator/ cases); each product then carries a rounding of about 5e-8
+  /// relative (the residual of an exact solution measured through it: 2e-8 to 9e-8 on the data
+  /// meshes), so it serves iterations stopped well above that (FlowSystemSolver's iterations at
+  /// tolerances of 1e-6 and more: at 1e-6 the data meshes take the iterations of exact products,
+  /// plus or minus four).
   enum class CachePrecision { Double, Float };
 
   explicit FlowOperator(const FlowTerms& terms, CachePrecision precision = CachePrecision::Double);

@@ -74,7 +74,7 @@ constexpr double kFlatCurvature = 0.01;
 constexpr Index kFlatRegionForMultilevel = 500;
 // The iterations' products keep the operator's per-vertex caches in float (flow_operator.h: 48
 // bytes per vertex less at the solve's peak) where they stop at a relative residual of at least
-// this, 30 times those products' rounding (about 3e-8); tighter tolerances get exact products,
+// this, 20 times those products' rounding (about 5e-8); tighter tolerances get exact products,
 // as b, the direct path and the reported residual always do.
 constexpr double kFloatCachesFromTolerance = 1e-6;
 // Otherwise block-Jacobi runs kProbeIterations, and if the Lanczos estimate of its total
