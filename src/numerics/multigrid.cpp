@@ -46,45 +46,15 @@ void parallel_rows(int rows, Body&& body) {
   parallel_for_index(rows, body, 128, kSerialBelow);
 }
 
-// Fixed chunks of rows for the transposes below: the result does not depend on them, and four
+// Fixed chunks of rows for transpose below: the result does not depend on them, and four
 // keep the per-chunk column counts small (4 ints per column) while two threads share the work.
 constexpr int kTransposeChunks = 4;
 
-// The blocks (r, c) of A with keep(r, c), written transposed into (column, block) at places
-// counted from first[c] for each column c, in order of r: the places of the serial loop over
-// rows. The chunks count their blocks per column, and then each writes its own from its own
-// offsets, in parallel: this transpose on one core was 1.5 s of the hierarchy's set-up at 10M
-// vertices, with the page faults of first writing the result (docs/benchmarks.md).
-template <class Scalar, class Keep>
-void scatter_transposed(const BasicBlockSparseMatrix<Scalar>& A, Keep&& keep, const std::vector<int>& first,
-                        std::vector<int>& column, std::vector<Eigen::Matrix<Scalar, 3, 3>>& block) {
-  const int chunk_rows = (A.rows + kTransposeChunks - 1) / kTransposeChunks;
-  std::vector<std::vector<int>> place(kTransposeChunks);
-  auto for_each_kept = [&](int chunk, auto&& visit) {
-    for (int r = chunk * chunk_rows; r < std::min(A.rows, (chunk + 1) * chunk_rows); ++r)
-      for (int m = A.start[static_cast<std::size_t>(r)]; m < A.start[static_cast<std::size_t>(r) + 1]; ++m)
-        if (keep(r, A.column[static_cast<std::size_t>(m)])) visit(r, m);
-  };
-  tbb::parallel_for(0, kTransposeChunks, [&](int chunk) {
-    std::vector<int>& count = place[static_cast<std::size_t>(chunk)];
-    count.assign(static_cast<std::size_t>(A.cols), 0);
-    for_each_kept(chunk, [&](int, int m) { ++count[static_cast<std::size_t>(A.column[static_cast<std::size_t>(m)])]; });
-  });
-  parallel_rows(A.cols, [&](int c) {  // counts -> each chunk's first place in column c
-    int next = first[static_cast<std::size_t>(c)];
-    for (std::vector<int>& count : place) next += std::exchange(count[static_cast<std::size_t>(c)], next);
-  });
-  tbb::parallel_for(0, kTransposeChunks, [&](int chunk) {
-    std::vector<int>& next = place[static_cast<std::size_t>(chunk)];
-    for_each_kept(chunk, [&](int r, int m) {
-      const auto out =
-          static_cast<std::size_t>(next[static_cast<std::size_t>(A.column[static_cast<std::size_t>(m)])]++);
-      column[out] = r;
-      block[out] = A.block[static_cast<std::size_t>(m)].transpose();
-    });
-  });
-}
-
+// A^T. The blocks (r, c) of A are written transposed at places counted from T.start[c] for each
+// column c, in order of r: the places of the serial loop over rows. Fixed chunks of rows count
+// their blocks per column, and then each writes its own from its own offsets, in parallel: this
+// transpose on one core was 1.5 s of the hierarchy's set-up at 10M vertices, with the page faults
+// of first writing the result (docs/benchmarks.md).
 template <class Scalar>
 BasicBlockSparseMatrix<Scalar> transpose(const BasicBlockSparseMatrix<Scalar>& A) {
   BasicBlockSparseMatrix<Scalar> T;
@@ -94,9 +64,32 @@ BasicBlockSparseMatrix<Scalar> transpose(const BasicBlockSparseMatrix<Scalar>& A
   for (const int c : A.column) ++T.start[static_cast<std::size_t>(c) + 1];
   std::partial_sum(T.start.begin(), T.start.end(), T.start.begin());
   T.column.resize(A.column.size());
-  T.block.resize(A.block.size());  // not initialised: scatter_transposed writes each block once
-  scatter_transposed(
-      A, [](int, int) { return true; }, T.start, T.column, T.block);
+  T.block.resize(A.block.size());  // not initialised: each block is written once below
+  const int chunk_rows = (A.rows + kTransposeChunks - 1) / kTransposeChunks;
+  std::vector<std::vector<int>> place(kTransposeChunks);
+  auto for_each_in_chunk = [&](int chunk, auto&& visit) {
+    for (int r = chunk * chunk_rows; r < std::min(A.rows, (chunk + 1) * chunk_rows); ++r)
+      for (int m = A.start[static_cast<std::size_t>(r)]; m < A.start[static_cast<std::size_t>(r) + 1]; ++m) visit(r, m);
+  };
+  tbb::parallel_for(0, kTransposeChunks, [&](int chunk) {
+    std::vector<int>& count = place[static_cast<std::size_t>(chunk)];
+    count.assign(static_cast<std::size_t>(A.cols), 0);
+    for_each_in_chunk(chunk,
+                      [&](int, int m) { ++count[static_cast<std::size_t>(A.column[static_cast<std::size_t>(m)])]; });
+  });
+  parallel_rows(A.cols, [&](int c) {  // counts -> each chunk's first place in column c
+    int next = T.start[static_cast<std::size_t>(c)];
+    for (std::vector<int>& count : place) next += std::exchange(count[static_cast<std::size_t>(c)], next);
+  });
+  tbb::parallel_for(0, kTransposeChunks, [&](int chunk) {
+    std::vector<int>& next = place[static_cast<std::size_t>(chunk)];
+    for_each_in_chunk(chunk, [&](int r, int m) {
+      const auto out =
+          static_cast<std::size_t>(next[static_cast<std::size_t>(A.column[static_cast<std::size_t>(m)])]++);
+      T.column[out] = r;
+      T.block[out] = A.block[static_cast<std::size_t>(m)].transpose();
+    });
+  });
   return T;
 }
 
@@ -374,34 +367,26 @@ BlockSparseMatrix build_block_rows(int rows, int cols, const std::function<void(
 }
 
 BlockSparseMatrix symmetric_from_upper(const BlockSparseMatrix& upper) {
-  // Row k: the strictly lower blocks (upper's blocks (r, k), r < k, transposed, in order of r),
-  // then row k of upper (columns >= k); both parts are sorted, so the row is. Written straight
-  // into place: a transpose and rows under construction (build_block_rows) beside it were the
-  // flow's peak memory on large meshes once the Galerkin product was built in ranges.
+  // Row k as the set-up reads it from the upper half (UpperHalf): the transposes of upper's
+  // blocks (r, k), r < k, in order of r, then row k of upper; both parts are sorted, so the row
+  // is. Written straight into place, each row by one task.
+  const UpperHalf half(upper);
   const auto rows = static_cast<std::size_t>(upper.rows);
   BlockSparseMatrix S;
   S.rows = upper.rows;
   S.cols = upper.cols;
-  std::vector<int> lower_count(rows, 0);
-  for (std::size_t r = 0; r < rows; ++r)
-    for (int m = upper.start[r]; m < upper.start[r + 1]; ++m)
-      if (upper.column[static_cast<std::size_t>(m)] != static_cast<int>(r))
-        ++lower_count[static_cast<std::size_t>(upper.column[static_cast<std::size_t>(m)])];
   S.start.assign(rows + 1, 0);
   for (std::size_t k = 0; k < rows; ++k)
-    S.start[k + 1] = S.start[k] + lower_count[k] + (upper.start[k + 1] - upper.start[k]);
+    S.start[k + 1] =
+        S.start[k] + (half.lower_start[k + 1] - half.lower_start[k]) + (upper.start[k + 1] - upper.start[k]);
   S.column.resize(static_cast<std::size_t>(S.start.back()));
   S.block.resize(static_cast<std::size_t>(S.start.back()));
-  // Row k's lower part first, from upper's blocks (r, k), r < k, in order of r.
-  scatter_transposed(
-      upper, [](int r, int c) { return c != r; }, S.start, S.column, S.block);
   parallel_rows(upper.rows, [&](int k) {
-    const auto row = static_cast<std::size_t>(k);
-    auto out = static_cast<std::size_t>(S.start[row] + lower_count[row]);
-    for (int m = upper.start[row]; m < upper.start[row + 1]; ++m, ++out) {
-      S.column[out] = upper.column[static_cast<std::size_t>(m)];
-      S.block[out] = upper.block[static_cast<std::size_t>(m)];
-    }
+    auto out = static_cast<std::size_t>(S.start[static_cast<std::size_t>(k)]);
+    for_each_in_row(half, k, [&](int column, const Matrix3& block) {
+      S.column[out] = column;
+      S.block[out++] = block;
+    });
   });
   return S;
 }
