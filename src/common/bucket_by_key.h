@@ -7,6 +7,8 @@
 // deterministic.
 #pragma once
 
+#include <tbb/parallel_for.h>
+
 #include <cstddef>
 #include <span>
 #include <vector>
@@ -39,6 +41,40 @@ KeyBuckets<Item, Offset> bucket_by_key(std::size_t num_keys, ForEach&& for_each)
   buckets.items.resize(static_cast<std::size_t>(buckets.start[num_keys]));
   std::vector<Offset> fill(buckets.start.begin(), buckets.start.end() - 1);
   for_each([&](std::size_t key, const Item& item) { buckets.items[static_cast<std::size_t>(fill[key]++)] = item; });
+  return buckets;
+}
+
+/// bucket_by_key over the items of `num_chunks` fixed chunks, counted and placed in parallel:
+/// `for_each_in(chunk, emit)` calls emit(key, item) for the items of `chunk` (the same sequence
+/// each time, as it is called twice per chunk). The result is bucket_by_key's over the chunks'
+/// items in chunk order, whatever the threads: each key's items are placed chunk after chunk,
+/// from offsets of per-chunk counts (num_chunks x num_keys of them, so for a few chunks).
+template <class Item, class Offset = std::size_t, class ForEachIn>
+KeyBuckets<Item, Offset> bucket_by_key_in_chunks(std::size_t num_keys, std::size_t num_chunks,
+                                                 ForEachIn&& for_each_in) {
+  std::vector<std::vector<Offset>> place(num_chunks);
+  tbb::parallel_for(std::size_t{0}, num_chunks, [&](std::size_t c) {
+    std::vector<Offset>& count = place[c];
+    count.assign(num_keys, 0);
+    for_each_in(c, [&](std::size_t key, const Item&) { ++count[key]; });
+  });
+  KeyBuckets<Item, Offset> buckets;
+  buckets.start.assign(num_keys + 1, 0);
+  for (std::size_t k = 0; k < num_keys; ++k) {  // counts -> each chunk's first place for key k
+    Offset next = buckets.start[k];
+    for (std::vector<Offset>& count : place) {
+      const Offset n = count[k];
+      count[k] = next;
+      next += n;
+    }
+    buckets.start[k + 1] = next;
+  }
+  buckets.items.resize(static_cast<std::size_t>(buckets.start[num_keys]));
+  tbb::parallel_for(std::size_t{0}, num_chunks, [&](std::size_t c) {
+    std::vector<Offset>& next = place[c];
+    for_each_in(
+        c, [&](std::size_t key, const Item& item) { buckets.items[static_cast<std::size_t>(next[key]++)] = item; });
+  });
   return buckets;
 }
 

@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <memory>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -286,11 +288,22 @@ double FlowOperator::passes(std::vector<Cache>& kx, std::vector<Cache>& qkr, con
 BlockSparseMatrix galerkin_upper(const FlowTerms& t, const AggregationCoarseSpace& space) {
   const auto n = static_cast<std::size_t>(t.n);
   const auto na = static_cast<std::size_t>(space.size());
+  // The rows are built for a range of aggregates at a time, from the locals (below) of the
+  // vertices that touch it only: the locals of all vertices at once (96 bytes each, about 5.6
+  // per vertex) were the flow's peak memory on large meshes (540 of 2,129 bytes per vertex at
+  // 2.8M vertices, docs/benchmarks.md). Vertices and aggregates are numbered along the surface,
+  // so a range's vertices are about its share; a vertex on a range's edge computes its locals
+  // twice. Each block is still summed over the vertices in order, so the matrix does not depend
+  // on the ranges. 64 rather than 32: build_block_rows holds a range's rows twice while it
+  // copies them into place, which raised the 10M peak by about 100 MB (docs/benchmarks.md).
+  constexpr std::size_t kRanges = 64, kMinRange = 4096;
+  static_assert(kRanges <= 256, "range numbers are stored in a byte");
+  const std::size_t range = std::max(kMinRange, (na + kRanges - 1) / kRanges);
   // Per vertex i (the rows of A at i, fixed vertices included): for each aggregate a whose
   // basis function is non-zero on the star of i, phi_a(i), the 3x3 block (G Phi_a)_i and the
-  // entry (L phi_a)_i: its "locals". First their number and the range of their aggregates.
+  // entry (L phi_a)_i: its "locals". First their number and the ranges of their aggregates.
   std::vector<std::uint32_t> local_size(n, 0);
-  std::vector<Index> lowest(n, static_cast<Index>(na)), highest(n, -1);
+  std::vector<std::uint8_t> first_range(n, 0), last_range(n, 0);
   tbb::enumerable_thread_specific<std::vector<Index>> seen;
   parallel_for_index(t.n, [&](Index i) {
     std::vector<Index>& aggregates = seen.local();  // distinct, a handful: linear search
@@ -302,43 +315,50 @@ BlockSparseMatrix galerkin_upper(const FlowTerms& t, const AggregationCoarseSpac
     });
     const auto v = static_cast<std::size_t>(i);
     local_size[v] = static_cast<std::uint32_t>(aggregates.size());
-    for (const Index a : aggregates) {
-      lowest[v] = std::min(lowest[v], a);
-      highest[v] = std::max(highest[v], a);
-    }
+    if (aggregates.empty()) return;
+    const auto [lowest, highest] = std::minmax_element(aggregates.begin(), aggregates.end());
+    first_range[v] = static_cast<std::uint8_t>(static_cast<std::size_t>(*lowest) / range);
+    last_range[v] = static_cast<std::uint8_t>(static_cast<std::size_t>(*highest) / range);
   });
+  // The vertices that touch each range, in vertex order: found once, where scanning every
+  // vertex for every range was a serial pass per range (about 2 s at 10M vertices).
+  const std::size_t ranges = (na + range - 1) / range;
+  KeyBuckets<Index, std::uint32_t> range_vertices = bucket_by_key<Index, std::uint32_t>(ranges, [&](auto&& emit) {
+    for (std::size_t i = 0; i < n; ++i)
+      if (local_size[i] > 0)
+        for (std::size_t r = first_range[i]; r <= last_range[i]; ++r) emit(r, static_cast<Index>(i));
+  });
+  std::vector<std::uint8_t>().swap(first_range);
+  std::vector<std::uint8_t>().swap(last_range);
 
-  // The rows are built for a range of aggregates at a time, from the locals of the vertices that
-  // touch it only: the locals of all vertices at once (96 bytes each, about 5.6 per vertex) were
-  // the flow's peak memory on large meshes (540 of 2,129 bytes per vertex at 2.8M vertices,
-  // docs/benchmarks.md). Vertices and aggregates are numbered along the surface, so a range's
-  // vertices are about its share; a vertex on a range's edge computes its locals twice. Each
-  // block is still summed over the vertices in order, so the matrix does not depend on the
-  // ranges. 64 rather than 32: build_block_rows holds a range's rows twice while it copies them
-  // into place, which raised the 10M peak by about 100 MB (docs/benchmarks.md).
-  constexpr std::size_t kRanges = 64, kMinRange = 4096;
-  const std::size_t range = std::max(kMinRange, (na + kRanges - 1) / kRanges);
-  std::vector<Index> vertices;
+  std::span<const Index> vertices;
   std::vector<std::size_t> local_start;
-  std::vector<Local> locals;
+  // The range's locals; not initialised (every one is written below), and kept between ranges.
+  std::unique_ptr<Local[]> locals;
+  std::size_t locals_capacity = 0;
+  // Their aggregates again, packed: the counting sort below reads 4 bytes per local instead of
+  // a local's cache line (at 10M vertices its two passes took 0.7 s, from the locals).
+  std::vector<Index> local_aggregate;
   std::size_t first = 0;                                        // the range's first aggregate
   KeyBuckets<std::pair<std::uint32_t, std::uint32_t>> touches;  // per aggregate of the range: (vertex in range, k)
   auto prepare = [&](int range_first, int range_last) {
     const auto a0 = static_cast<std::size_t>(range_first), a1 = static_cast<std::size_t>(range_last);
     first = a0;
-    vertices.clear();
-    for (std::size_t i = 0; i < n; ++i)
-      if (local_size[i] > 0 && static_cast<std::size_t>(lowest[i]) < a1 && static_cast<std::size_t>(highest[i]) >= a0)
-        vertices.push_back(static_cast<Index>(i));
+    vertices = range_vertices.of(a0 / range);
     const std::size_t m = vertices.size();
     local_start.assign(m + 1, 0);
     for (std::size_t c = 0; c < m; ++c)
       local_start[c + 1] = local_start[c] + local_size[static_cast<std::size_t>(vertices[c])];
-    locals.assign(local_start[m], Local{});
+    if (local_start[m] > locals_capacity) {
+      locals.reset();
+      locals_capacity = local_start[m] + local_start[m] / 8;
+      locals.reset(new Local[locals_capacity]);
+    }
+    local_aggregate.resize(local_start[m]);
     parallel_for_index(static_cast<Index>(m), [&](Index c) {
       const Index i = vertices[static_cast<std::size_t>(c)];
       const auto v = static_cast<std::size_t>(i);
-      Local* out = locals.data() + local_start[static_cast<std::size_t>(c)];
+      Local* out = locals.get() + local_start[static_cast<std::size_t>(c)];
       std::uint32_t size = 0;
       auto find = [&](Index a) -> Local& {
         for (std::uint32_t k = 0; k < size; ++k)
@@ -363,16 +383,22 @@ BlockSparseMatrix galerkin_upper(const FlowTerms& t, const AggregationCoarseSpac
         }
       }
       std::sort(out, out + size, [](const Local& x, const Local& y) { return x.aggregate < y.aggregate; });
+      for (std::uint32_t k = 0; k < size; ++k)
+        local_aggregate[local_start[static_cast<std::size_t>(c)] + k] = out[k].aggregate;
     });
-    // The locals of each aggregate of the range, by vertex (counting sort, so in vertex order).
-    touches = bucket_by_key<std::pair<std::uint32_t, std::uint32_t>>(a1 - a0, [&](auto&& emit) {
-      for (std::size_t c = 0; c < m; ++c)
-        for (std::size_t k = local_start[c]; k < local_start[c + 1]; ++k) {
-          const auto a = static_cast<std::size_t>(locals[k].aggregate);
-          if (a >= a0 && a < a1)
-            emit(a - a0, std::pair{static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(k - local_start[c])});
-        }
-    });
+    // The locals of each aggregate of the range, by vertex (a counting sort, so in vertex
+    // order; in fixed chunks of the vertices, counted and placed on all threads).
+    constexpr std::size_t kChunks = 8;
+    const std::size_t chunk = (m + kChunks - 1) / kChunks;
+    touches = bucket_by_key_in_chunks<std::pair<std::uint32_t, std::uint32_t>>(
+        a1 - a0, kChunks, [&](std::size_t part, auto&& emit) {
+          for (std::size_t c = part * chunk; c < std::min(m, (part + 1) * chunk); ++c)
+            for (std::size_t k = local_start[c]; k < local_start[c + 1]; ++k) {
+              const auto a = static_cast<std::size_t>(local_aggregate[k]);
+              if (a >= a0 && a < a1)
+                emit(a - a0, std::pair{static_cast<std::uint32_t>(c), static_cast<std::uint32_t>(k - local_start[c])});
+            }
+        });
   };
   // Row a of the upper half of H_c: blocks (a, b), b >= a, summed over the vertices in order.
   return build_block_rows(
@@ -381,7 +407,7 @@ BlockSparseMatrix galerkin_upper(const FlowTerms& t, const AggregationCoarseSpac
         const std::size_t r = static_cast<std::size_t>(a) - first;
         for (const auto& [c, k] : touches.of(r)) {
           const auto v = static_cast<std::size_t>(vertices[c]);
-          const Local* local = locals.data() + local_start[c];
+          const Local* local = locals.get() + local_start[c];
           const Local& x = local[k];
           const Eigen::Matrix3d left = x.g * t.P[v].full();
           const Eigen::Matrix3d D = t.D[v].full();             // phi is 0 at fixed vertices, so their D drops out

@@ -196,7 +196,8 @@ double spectral_radius(const std::vector<Matrix3>& inverse_diagonal, const Rows&
   double lambda = 1;
   for (int iteration = 0; iteration < kPowerIterations; ++iteration) {
     multiply(A, v, w);
-    for (int k = 0; k < A.rows; ++k) block_at(w, k) = inverse_diagonal[static_cast<std::size_t>(k)] * block_at(w, k);
+    parallel_rows(A.rows,
+                  [&](int k) { block_at(w, k) = inverse_diagonal[static_cast<std::size_t>(k)] * block_at(w, k); });
     lambda = w.norm() / v.norm();
     v = w / w.norm();
   }

@@ -1,0 +1,64 @@
+// The counting sorts of src/common/bucket_by_key.h: the chunked, parallel one groups exactly as
+// the serial one does over the same items, whatever the chunks.
+#include "common/bucket_by_key.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdint>
+#include <random>
+#include <utility>
+#include <vector>
+
+namespace vertexflow {
+namespace {
+
+// Items (key, payload) with keys skewed towards the low ones and some keys never used.
+std::vector<std::pair<std::size_t, int>> random_items(std::size_t count, std::size_t num_keys, unsigned seed) {
+  std::mt19937 random(seed);
+  std::uniform_int_distribution<std::size_t> uniform(0, num_keys - 1);
+  std::vector<std::pair<std::size_t, int>> items;
+  for (std::size_t k = 0; k < count; ++k) {
+    const std::size_t key = std::min(uniform(random), uniform(random)) / 2 * 2;  // odd keys stay empty
+    items.emplace_back(key, static_cast<int>(k));
+  }
+  return items;
+}
+
+TEST(BucketByKey, GroupsStablyByKey) {
+  const auto items = random_items(5000, 101, 1);
+  const KeyBuckets<int> buckets = bucket_by_key<int>(101, [&](auto&& emit) {
+    for (const auto& [key, payload] : items) emit(key, payload);
+  });
+  ASSERT_EQ(buckets.start.size(), 102u);
+  EXPECT_EQ(buckets.items.size(), items.size());
+  KeyBuckets<int> copy = buckets;
+  for (std::size_t key = 0; key < 101; ++key) {
+    std::vector<int> expected;
+    for (const auto& [k, payload] : items)
+      if (k == key) expected.push_back(payload);
+    const auto got = copy.of(key);
+    EXPECT_EQ(std::vector<int>(got.begin(), got.end()), expected) << "key " << key;
+  }
+}
+
+TEST(BucketByKey, InChunksGivesTheSerialResult) {
+  for (const std::size_t count : {0ul, 1ul, 7ul, 5000ul}) {
+    const auto items = random_items(count, 101, 2 + static_cast<unsigned>(count));
+    const KeyBuckets<int, std::uint32_t> serial = bucket_by_key<int, std::uint32_t>(101, [&](auto&& emit) {
+      for (const auto& [key, payload] : items) emit(key, payload);
+    });
+    for (const std::size_t chunks : {1ul, 3ul, 8ul, 64ul}) {  // 64 > 7 items: empty chunks
+      const std::size_t chunk = (count + chunks - 1) / chunks;
+      const KeyBuckets<int, std::uint32_t> chunked =
+          bucket_by_key_in_chunks<int, std::uint32_t>(101, chunks, [&](std::size_t part, auto&& emit) {
+            for (std::size_t k = part * chunk; k < std::min(count, (part + 1) * chunk); ++k)
+              emit(items[k].first, items[k].second);
+          });
+      EXPECT_EQ(chunked.start, serial.start) << count << " items in " << chunks << " chunks";
+      EXPECT_EQ(chunked.items, serial.items) << count << " items in " << chunks << " chunks";
+    }
+  }
+}
+
+}  // namespace
+}  // namespace vertexflow
