@@ -6,7 +6,9 @@ Runs COMMAND under `/usr/bin/time -v`, samples the command's resident set (VmRSS
 ("vertexflow: reading ...", "flowing ...", "writing ...", "report written ..."). Prints one JSON
 object: the peak RSS and wall of /usr/bin/time, the stderr lines with their times, the peak RSS
 between each line and the next (the phases the CLI names), and with --trace the whole sampled
-series.
+series. Each phase also gets the command's system CPU time in it and the transparent huge pages
+the kernel faulted in meanwhile (the machine's thp_fault_alloc, 2 MiB each): on this VM zeroing
+fresh pages is a large part of a 10M run (docs/benchmarks.md).
 
     bench/memory_profile.py [--interval 0.02] [--trace FILE.tsv] -- \
         build/bin/vertexflow enhance /tmp/vf29/arm1m.ply /tmp/vf29/out.ply --report /tmp/vf29/r.json
@@ -33,6 +35,25 @@ def rss_kib(pid):
                     return int(line.split()[1])
     except (FileNotFoundError, ProcessLookupError):
         return None
+    return 0
+
+
+def system_seconds(pid):
+    """The process's system CPU time (stime, field 15 of /proc/PID/stat)."""
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            fields = f.read().rsplit(")", 1)[1].split()
+        return int(fields[12]) / os.sysconf("SC_CLK_TCK")
+    except (FileNotFoundError, ProcessLookupError, IndexError):
+        return None
+
+
+def huge_page_faults():
+    """Transparent huge pages faulted in since boot, machine-wide (/proc/vmstat)."""
+    with open("/proc/vmstat") as f:
+        for line in f:
+            if line.startswith("thp_fault_alloc "):
+                return int(line.split()[1])
     return 0
 
 
@@ -74,6 +95,7 @@ def main():
     reader = threading.Thread(target=read_stderr)
     reader.start()
     samples = []  # (seconds, KiB)
+    counters = []  # (seconds, system CPU seconds of the command, huge pages faulted machine-wide)
     target = None
     while proc.poll() is None:
         if target is None:
@@ -81,7 +103,11 @@ def main():
         if target is not None:
             kib = rss_kib(target)
             if kib is not None:
-                samples.append((time.monotonic() - t0, kib))
+                now = time.monotonic() - t0
+                samples.append((now, kib))
+                sys_s = system_seconds(target)
+                if sys_s is not None:
+                    counters.append((now, sys_s, huge_page_faults()))
         time.sleep(args.interval)
     reader.join()
     busy = busy_cpu_seconds() - busy0
@@ -140,6 +166,15 @@ def main():
                 inside = [k for s_, k in samples if a <= s_ <= b]
                 return round(max(inside) / 1024, 1) if inside else None
 
+            def grown(a, b):  # (system seconds, huge-page MiB) from the last sample before a to the last before b
+                before = [c for c in counters if c[0] <= a]
+                until = [c for c in counters if c[0] <= b]
+                if not until:
+                    return None, None
+                first = before[-1] if before else (0.0, 0.0, counters[0][2])
+                last = until[-1]
+                return round(last[1] - first[1], 2), 2 * (last[2] - first[2])
+
             order = ["curvature", "assembly", "factorization", "solve", "projection", "guard"]
             read_end = at["reading"] + seconds["read"]
             untimed = (at["timed"] - at["flowing"]) - sum(seconds[k] for k in order)
@@ -154,7 +189,10 @@ def main():
             metrics_start = at["writing"] + seconds["write"]
             rows.append(("untimed: report metrics", at["written"] - metrics_start, metrics_start))
             result["by_phase"] = [{"phase": name, "seconds": round(length, 3),
-                                   "peak_rss_MiB": peak(begin, begin + length)} for name, length, begin in rows]
+                                   "peak_rss_MiB": peak(begin, begin + length),
+                                   "system_s": grown(begin, begin + length)[0],
+                                   "huge_page_faults_MiB": grown(begin, begin + length)[1]}
+                                  for name, length, begin in rows]
             if wall_s is not None:
                 result["by_phase"].append({"phase": "untimed: start and exit",
                                            "seconds": round(wall_s - (at["written"] - at["reading"]), 3),
