@@ -20,14 +20,18 @@ namespace {
 // default, 6,088,980 KB), 635 and 627 with --report (850,848 and 6,140,620 KB); block-Jacobi
 // alone (--solver iterative) 456 at 1M (661,500 KB), and with --report, whose metrics are then
 // the peak, 605 at 1M (819,372 KB) and 624 at 10M (6,108,084 KB). With a report both paths peak
-// alike, so the estimates are of runs with one, block-Jacobi's a little lower; the fixed part
-// and a reference vertex's cost are as fitted before (the fixed part was 128 MiB before the
-// CLI's jemalloc, which holds up to about 40 MB more on small meshes: a 163,842-vertex sphere
-// 224.7 -> 265.7 MB with thp:always alone).
+// alike, so the estimates are of runs with one, block-Jacobi's a little lower. The fixed part
+// is as fitted before (128 MiB before the CLI's jemalloc, which holds up to about 40 MB more on
+// small meshes: a 163,842-vertex sphere 224.7 -> 265.7 MB with thp:always alone). A reference
+// vertex (its V and F, trees, samples and curvature) measured 181-182 B: a 100,002-vertex QEM of
+// arm1m fitted to arm1m, arm10m and arm27m with --report peaked at 398.5, 1,963.4 and 5,118.9 MB,
+// linear in the reference's 1.08M, 9.73M and 27.0M vertices; sphere_low fitted to Loop
+// subdivisions of sphere.off (257k and 1.03M vertices) 153 B. 250 leaves a margin for fits that
+// take more rounds (docs/benchmarks.md, "The reference's part of the estimate").
 constexpr double kFixedBytes = 176.0 * 1024 * 1024;
 constexpr double kBytesPerVertexMultilevel = 680;
 constexpr double kBytesPerVertexBlockJacobi = 650;
-constexpr double kReferenceBytesPerVertex = 900;
+constexpr double kReferenceBytesPerVertex = 250;
 
 // A "Key:   N kB" line of a /proc file, in bytes.
 std::optional<std::uint64_t> proc_kib(const char* file, const std::string& key) {

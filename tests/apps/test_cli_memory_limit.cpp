@@ -176,6 +176,29 @@ TEST(CliMemoryLimit, TheEstimateBoundsTheMeasuredPeakOnEachSolverPath) {
             estimated_enhance_peak_bytes(1000000, false, 0, LinearSolver::Automatic));
 }
 
+// The reference's part of the estimate bounds what a reference costs, and not loosely: a
+// 642-vertex sphere fitted to a 655,362-vertex one measured 230.1-239.6 MB against an estimate
+// of 348.8 MB (1.46-1.52x); without the reference's term (184.9 MB) or with its old 900 B per
+// vertex (774.7 MB, 3.2x) the bounds fail.
+TEST(CliMemoryLimit, TheEstimateBoundsTheMeasuredPeakInReferenceMode) {
+  const test::ScratchDir scratch("estimate-reference");
+  const std::string coarse = scratch.file("coarse.ply").string(), dense = scratch.file("dense.ply").string();
+  const Mesh input = test::icosphere(1.0, 3), reference = test::icosphere(1.0, 8);
+  write_mesh(coarse, input);
+  write_mesh(dense, reference);
+  const std::string report = scratch.file("r.json").string();
+  const auto r = test::run_cli("--quiet enhance " + test::shell_quote(coarse) + " " +
+                               test::shell_quote(scratch.file("out.ply").string()) + " --reference " +
+                               test::shell_quote(dense) + " --report " + test::shell_quote(report));
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto peak = nlohmann::json::parse(test::read_text(report))["peak_memory_bytes"].get<double>();
+  const auto estimate =
+      static_cast<double>(estimated_enhance_peak_bytes(input.num_vertices(), true, reference.num_vertices()));
+  std::cout << "[measured] reference mode: peak " << peak / 1e6 << " MB, estimate " << estimate / 1e6 << " MB\n";
+  EXPECT_LE(peak, estimate);
+  EXPECT_LE(estimate, 2 * peak);
+}
+
 // The plan before a run (memory.h) at 10M vertices, against what is available: Automatic keeps
 // its path when the multilevel estimate fits, runs block-Jacobi alone (and says so) when only that
 // fits, and refuses with the lighter path's estimate when neither does; an explicit solver is
