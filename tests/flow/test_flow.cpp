@@ -329,19 +329,34 @@ TEST(FlowHardCases, NoisyScanWithSlivers) {
   expect_flow_effect(scan, result, {"noisy scan", 0.066, 0.045, 0.00075, 0.01, 0.083});
 }
 
+// A flat grid (the saddle's (x, y), z = 0; spacing 2 half / n), its topology and its boundary
+// vertices fixed: the guard tests' mesh.
+struct FlatGrid {
+  Mesh mesh;
+  Topology topology;
+  std::vector<char> fixed;
+};
+
+FlatGrid flat_grid(double half, int n) {
+  FlatGrid grid;
+  grid.mesh = test::saddle(half, n);
+  grid.mesh.V.col(2).setZero();
+  grid.topology = build_topology(grid.mesh.F, grid.mesh.num_vertices());
+  grid.fixed.assign(static_cast<std::size_t>(grid.mesh.num_vertices()), 0);
+  for (std::size_t v = 0; v < grid.fixed.size(); ++v) grid.fixed[v] = grid.topology.is_boundary_vertex[v];
+  return grid;
+}
+
 // The guard itself (src/guard/guard.h), on a flat grid where the proposed move of one vertex
 // flips faces while every other vertex makes a small good move: the guard repairs the flipped
 // faces by shortening only the vertex that flipped them, and leaves every other proposed move
 // as it was.
 TEST(FlowGuard, RepairsBadFacesAndKeepsEveryGoodMove) {
-  const Mesh grid = test::saddle(5.0, 10);  // 11 x 11 vertices, spacing 1
-  Mesh flat = grid;
-  flat.V.col(2).setZero();
+  const FlatGrid grid = flat_grid(5.0, 10);  // 11 x 11 vertices, spacing 1
+  const Mesh& flat = grid.mesh;
+  const Topology& topology = grid.topology;
+  const std::vector<char>& fixed = grid.fixed;
   const Index n = flat.num_vertices();
-  const Topology topology = build_topology(flat.F, n);
-  std::vector<char> fixed(static_cast<std::size_t>(n), 0);
-  for (Index v = 0; v < n; ++v)
-    fixed[static_cast<std::size_t>(v)] = topology.is_boundary_vertex[static_cast<std::size_t>(v)];
   // Every free vertex moves by 0.1 along a direction of its own; the centre vertex (5, 5) moves by
   // 1.6 edge lengths, across its neighbours.
   Vertices proposed = flat.V;
@@ -396,13 +411,11 @@ TEST(FlowGuard, RepairsBadFacesAndKeepsEveryGoodMove) {
 // move 0.6 edge lengths in a direction of their own flips thousands of faces (measured: 2,631 of
 // 20,000 flipped before the guard, 8,894 vertices shortened).
 TEST(FlowGuard, ThousandsOfBadFacesGiveTheSameResultOnAnyThreadCount) {
-  Mesh flat = test::saddle(50.0, 100);  // spacing 1
-  flat.V.col(2).setZero();
+  const FlatGrid grid = flat_grid(50.0, 100);  // spacing 1
+  const Mesh& flat = grid.mesh;
+  const Topology& topology = grid.topology;
+  const std::vector<char>& fixed = grid.fixed;
   const Index n = flat.num_vertices();
-  const Topology topology = build_topology(flat.F, n);
-  std::vector<char> fixed(static_cast<std::size_t>(n), 0);
-  for (Index v = 0; v < n; ++v)
-    fixed[static_cast<std::size_t>(v)] = topology.is_boundary_vertex[static_cast<std::size_t>(v)];
   Vertices proposed = flat.V;
   for (Index v = 0; v < n; ++v) {
     if (fixed[static_cast<std::size_t>(v)]) continue;
