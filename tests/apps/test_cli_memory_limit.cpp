@@ -154,6 +154,9 @@ TEST(CliMemoryLimit, WhereOnlyTheMultilevelPathWouldNotFitBlockJacobiRunsAndSays
 // (block-Jacobi) and 277.4 MB (multilevel) against estimates of 291.0 and 296.0 MB (1.15x and
 // 1.07x).
 TEST(CliMemoryLimit, TheEstimateBoundsTheMeasuredPeakOnEachSolverPath) {
+#ifdef VERTEXFLOW_TEST_ASAN
+  GTEST_SKIP() << "the estimate is of the release CLI's peaks; AddressSanitizer's shadow memory and allocator are not";
+#endif
   const test::ScratchDir scratch("estimate-bound");
   const std::string sphere = scratch.file("sphere.ply").string();
   const Mesh mesh = test::icosphere(1.0, 7);
@@ -181,6 +184,9 @@ TEST(CliMemoryLimit, TheEstimateBoundsTheMeasuredPeakOnEachSolverPath) {
 // of 348.8 MB (1.46-1.52x); without the reference's term (184.9 MB) or with its old 900 B per
 // vertex (774.7 MB, 3.2x) the bounds fail.
 TEST(CliMemoryLimit, TheEstimateBoundsTheMeasuredPeakInReferenceMode) {
+#ifdef VERTEXFLOW_TEST_ASAN
+  GTEST_SKIP() << "the estimate is of the release CLI's peaks; AddressSanitizer's shadow memory and allocator are not";
+#endif
   const test::ScratchDir scratch("estimate-reference");
   const std::string coarse = scratch.file("coarse.ply").string(), dense = scratch.file("dense.ply").string();
   const Mesh input = test::icosphere(1.0, 3), reference = test::icosphere(1.0, 8);
