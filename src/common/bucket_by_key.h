@@ -44,37 +44,52 @@ KeyBuckets<Item, Offset> bucket_by_key(std::size_t num_keys, ForEach&& for_each)
   return buckets;
 }
 
+/// The counting sort of bucket_by_key_in_chunks below, for a caller that stores the items
+/// itself: `for_each_in(chunk, emit)` calls emit(key, item) for the items of `chunk` (the same
+/// sequence each time, as it is called twice per chunk); `reserve(total)` is called once the
+/// items are counted, and then `place(position, item)` for every item, from several threads,
+/// each position once. Returns the keys' starts: key k's items are placed at [start[k],
+/// start[k + 1]), chunk after chunk and in emitted order within a chunk, whatever the threads.
+/// The chunks are counted and placed in parallel, from per-chunk counts (num_chunks x num_keys
+/// of them, so for a few chunks).
+template <class Offset, class ForEachIn, class Reserve, class Place>
+std::vector<Offset> place_by_key_in_chunks(std::size_t num_keys, std::size_t num_chunks, ForEachIn&& for_each_in,
+                                           Reserve&& reserve, Place&& place) {
+  std::vector<std::vector<Offset>> next(num_chunks);
+  tbb::parallel_for(std::size_t{0}, num_chunks, [&](std::size_t c) {
+    std::vector<Offset>& count = next[c];
+    count.assign(num_keys, 0);
+    for_each_in(c, [&](std::size_t key, const auto&) { ++count[key]; });
+  });
+  std::vector<Offset> start(num_keys + 1, 0);
+  for (std::size_t k = 0; k < num_keys; ++k) {  // counts -> each chunk's first place for key k
+    Offset at = start[k];
+    for (std::vector<Offset>& count : next) {
+      const Offset n = count[k];
+      count[k] = at;
+      at += n;
+    }
+    start[k + 1] = at;
+  }
+  reserve(static_cast<std::size_t>(start[num_keys]));
+  tbb::parallel_for(std::size_t{0}, num_chunks, [&](std::size_t c) {
+    std::vector<Offset>& at = next[c];
+    for_each_in(c, [&](std::size_t key, const auto& item) { place(static_cast<std::size_t>(at[key]++), item); });
+  });
+  return start;
+}
+
 /// bucket_by_key over the items of `num_chunks` fixed chunks, counted and placed in parallel:
 /// `for_each_in(chunk, emit)` calls emit(key, item) for the items of `chunk` (the same sequence
-/// each time, as it is called twice per chunk). The result is bucket_by_key's over the chunks'
-/// items in chunk order, whatever the threads: each key's items are placed chunk after chunk,
-/// from offsets of per-chunk counts (num_chunks x num_keys of them, so for a few chunks).
+/// each time). The result is bucket_by_key's over the chunks' items in chunk order, whatever the
+/// threads (place_by_key_in_chunks).
 template <class Item, class Offset = std::size_t, class ForEachIn>
 KeyBuckets<Item, Offset> bucket_by_key_in_chunks(std::size_t num_keys, std::size_t num_chunks,
                                                  ForEachIn&& for_each_in) {
-  std::vector<std::vector<Offset>> place(num_chunks);
-  tbb::parallel_for(std::size_t{0}, num_chunks, [&](std::size_t c) {
-    std::vector<Offset>& count = place[c];
-    count.assign(num_keys, 0);
-    for_each_in(c, [&](std::size_t key, const Item&) { ++count[key]; });
-  });
   KeyBuckets<Item, Offset> buckets;
-  buckets.start.assign(num_keys + 1, 0);
-  for (std::size_t k = 0; k < num_keys; ++k) {  // counts -> each chunk's first place for key k
-    Offset next = buckets.start[k];
-    for (std::vector<Offset>& count : place) {
-      const Offset n = count[k];
-      count[k] = next;
-      next += n;
-    }
-    buckets.start[k + 1] = next;
-  }
-  buckets.items.resize(static_cast<std::size_t>(buckets.start[num_keys]));
-  tbb::parallel_for(std::size_t{0}, num_chunks, [&](std::size_t c) {
-    std::vector<Offset>& next = place[c];
-    for_each_in(
-        c, [&](std::size_t key, const Item& item) { buckets.items[static_cast<std::size_t>(next[key]++)] = item; });
-  });
+  buckets.start = place_by_key_in_chunks<Offset>(
+      num_keys, num_chunks, for_each_in, [&](std::size_t total) { buckets.items.resize(total); },
+      [&](std::size_t at, const Item& item) { buckets.items[at] = item; });
   return buckets;
 }
 

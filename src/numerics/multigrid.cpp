@@ -1,5 +1,6 @@
 #include "numerics/multigrid.h"
 
+#include "common/bucket_by_key.h"
 #include "numerics/block3.h"
 #include "numerics/parallel.h"
 
@@ -9,7 +10,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <numeric>
 #include <optional>
 #include <stdexcept>
 #include <utility>
@@ -50,46 +50,32 @@ void parallel_rows(int rows, Body&& body) {
 // keep the per-chunk column counts small (4 ints per column) while two threads share the work.
 constexpr int kTransposeChunks = 4;
 
-// A^T. The blocks (r, c) of A are written transposed at places counted from T.start[c] for each
-// column c, in order of r: the places of the serial loop over rows. Fixed chunks of rows count
-// their blocks per column, and then each writes its own from its own offsets, in parallel: this
-// transpose on one core was 1.5 s of the hierarchy's set-up at 10M vertices, with the page faults
-// of first writing the result (docs/benchmarks.md).
+// A^T: the blocks (r, c) of A, bucketed by column c in order of r (the places of the serial loop
+// over rows), written transposed. Counted and placed by fixed chunks of rows in parallel
+// (place_by_key_in_chunks): this transpose on one core was 1.5 s of the hierarchy's set-up at
+// 10M vertices, with the page faults of first writing the result (docs/benchmarks.md).
 template <class Scalar>
 BasicBlockSparseMatrix<Scalar> transpose(const BasicBlockSparseMatrix<Scalar>& A) {
   BasicBlockSparseMatrix<Scalar> T;
   T.rows = A.cols;
   T.cols = A.rows;
-  T.start.assign(static_cast<std::size_t>(T.rows) + 1, 0);
-  for (const int c : A.column) ++T.start[static_cast<std::size_t>(c) + 1];
-  std::partial_sum(T.start.begin(), T.start.end(), T.start.begin());
-  T.column.resize(A.column.size());
-  T.block.resize(A.block.size());  // not initialised: each block is written once below
   const int chunk_rows = (A.rows + kTransposeChunks - 1) / kTransposeChunks;
-  std::vector<std::vector<int>> place(kTransposeChunks);
-  auto for_each_in_chunk = [&](int chunk, auto&& visit) {
-    for (int r = chunk * chunk_rows; r < std::min(A.rows, (chunk + 1) * chunk_rows); ++r)
-      for (int m = A.start[static_cast<std::size_t>(r)]; m < A.start[static_cast<std::size_t>(r) + 1]; ++m) visit(r, m);
-  };
-  tbb::parallel_for(0, kTransposeChunks, [&](int chunk) {
-    std::vector<int>& count = place[static_cast<std::size_t>(chunk)];
-    count.assign(static_cast<std::size_t>(A.cols), 0);
-    for_each_in_chunk(chunk,
-                      [&](int, int m) { ++count[static_cast<std::size_t>(A.column[static_cast<std::size_t>(m)])]; });
-  });
-  parallel_rows(A.cols, [&](int c) {  // counts -> each chunk's first place in column c
-    int next = T.start[static_cast<std::size_t>(c)];
-    for (std::vector<int>& count : place) next += std::exchange(count[static_cast<std::size_t>(c)], next);
-  });
-  tbb::parallel_for(0, kTransposeChunks, [&](int chunk) {
-    std::vector<int>& next = place[static_cast<std::size_t>(chunk)];
-    for_each_in_chunk(chunk, [&](int r, int m) {
-      const auto out =
-          static_cast<std::size_t>(next[static_cast<std::size_t>(A.column[static_cast<std::size_t>(m)])]++);
-      T.column[out] = r;
-      T.block[out] = A.block[static_cast<std::size_t>(m)].transpose();
-    });
-  });
+  T.start = place_by_key_in_chunks<int>(
+      static_cast<std::size_t>(A.cols), kTransposeChunks,
+      [&](std::size_t chunk, auto&& emit) {  // block m of row r as (r, m), keyed by its column
+        for (int r = static_cast<int>(chunk) * chunk_rows;
+             r < std::min(A.rows, (static_cast<int>(chunk) + 1) * chunk_rows); ++r)
+          for (int m = A.start[static_cast<std::size_t>(r)]; m < A.start[static_cast<std::size_t>(r) + 1]; ++m)
+            emit(static_cast<std::size_t>(A.column[static_cast<std::size_t>(m)]), std::pair{r, m});
+      },
+      [&](std::size_t total) {
+        T.column.resize(total);
+        T.block.resize(total);  // not initialised: each block is written once
+      },
+      [&](std::size_t at, const std::pair<int, int>& block) {
+        T.column[at] = block.first;
+        T.block[at] = A.block[static_cast<std::size_t>(block.second)].transpose();
+      });
   return T;
 }
 
@@ -108,34 +94,27 @@ void for_each_in_row(const BlockSparseMatrix& A, int k, Visit&& visit) {
 // transposes. 8 bytes per such block, where the whole matrix would take another 72 + 4: the
 // whole first coarse matrix was the flow's peak memory on large meshes (docs/benchmarks.md).
 struct UpperHalf {
-  explicit UpperHalf(const BlockSparseMatrix& upper_half) : upper(upper_half), rows(upper.rows), cols(upper.cols) {
-    const auto n = static_cast<std::size_t>(rows);
-    lower_start.assign(n + 1, 0);
-    for (std::size_t r = 0; r < n; ++r)
-      for (int m = upper.start[r]; m < upper.start[r + 1]; ++m)
-        if (upper.column[static_cast<std::size_t>(m)] != static_cast<int>(r))
-          ++lower_start[static_cast<std::size_t>(upper.column[static_cast<std::size_t>(m)]) + 1];
-    std::partial_sum(lower_start.begin(), lower_start.end(), lower_start.begin());
-    lower.resize(static_cast<std::size_t>(lower_start.back()));
-    std::vector<int> next(lower_start.begin(), lower_start.end() - 1);
-    for (std::size_t r = 0; r < n; ++r)
-      for (int m = upper.start[r]; m < upper.start[r + 1]; ++m) {
-        const int c = upper.column[static_cast<std::size_t>(m)];
-        if (c != static_cast<int>(r))
-          lower[static_cast<std::size_t>(next[static_cast<std::size_t>(c)]++)] = {static_cast<int>(r), m};
-      }
-  }
+  explicit UpperHalf(const BlockSparseMatrix& upper_half)
+      : upper(upper_half),
+        rows(upper.rows),
+        cols(upper.cols),
+        lower(bucket_by_key<std::pair<int, int>, int>(static_cast<std::size_t>(rows), [&](auto&& emit) {
+          for (int r = 0; r < rows; ++r)
+            for (int m = upper.start[static_cast<std::size_t>(r)]; m < upper.start[static_cast<std::size_t>(r) + 1];
+                 ++m)
+              if (const int c = upper.column[static_cast<std::size_t>(m)]; c != r)
+                emit(static_cast<std::size_t>(c), std::pair{r, m});
+        })) {}
   const BlockSparseMatrix& upper;
   int rows, cols;
-  std::vector<int> lower_start;
-  std::vector<std::pair<int, int>> lower;  // (row r, place of block (r, k) in upper)
+  KeyBuckets<std::pair<int, int>, int> lower;  // per row k: (row r, place of block (r, k) in upper)
 };
 
 template <class Visit>
 void for_each_in_row(const UpperHalf& A, int k, Visit&& visit) {
   const auto row = static_cast<std::size_t>(k);
-  for (int p = A.lower_start[row]; p < A.lower_start[row + 1]; ++p) {
-    const auto [r, m] = A.lower[static_cast<std::size_t>(p)];
+  for (int p = A.lower.start[row]; p < A.lower.start[row + 1]; ++p) {
+    const auto [r, m] = A.lower.items[static_cast<std::size_t>(p)];
     const Matrix3 block = A.upper.block[static_cast<std::size_t>(m)].transpose();
     visit(r, block);
   }
@@ -379,7 +358,7 @@ BlockSparseMatrix symmetric_from_upper(const BlockSparseMatrix& upper) {
   S.start.assign(rows + 1, 0);
   for (std::size_t k = 0; k < rows; ++k)
     S.start[k + 1] =
-        S.start[k] + (half.lower_start[k + 1] - half.lower_start[k]) + (upper.start[k + 1] - upper.start[k]);
+        S.start[k] + (half.lower.start[k + 1] - half.lower.start[k]) + (upper.start[k + 1] - upper.start[k]);
   S.column.resize(static_cast<std::size_t>(S.start.back()));
   S.block.resize(static_cast<std::size_t>(S.start.back()));
   parallel_rows(upper.rows, [&](int k) {
