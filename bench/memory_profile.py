@@ -188,11 +188,12 @@ def main():
             rows.append(("write", seconds["write"], at["writing"]))
             metrics_start = at["writing"] + seconds["write"]
             rows.append(("untimed: report metrics", at["written"] - metrics_start, metrics_start))
-            result["by_phase"] = [{"phase": name, "seconds": round(length, 3),
-                                   "peak_rss_MiB": peak(begin, begin + length),
-                                   "system_s": grown(begin, begin + length)[0],
-                                   "huge_page_faults_MiB": grown(begin, begin + length)[1]}
-                                  for name, length, begin in rows]
+            result["by_phase"] = []
+            for name, length, begin in rows:
+                system_s, faulted = grown(begin, begin + length)
+                result["by_phase"].append({"phase": name, "seconds": round(length, 3),
+                                           "peak_rss_MiB": peak(begin, begin + length),
+                                           "system_s": system_s, "huge_page_faults_MiB": faulted})
             if wall_s is not None:
                 result["by_phase"].append({"phase": "untimed: start and exit",
                                            "seconds": round(wall_s - (at["written"] - at["reading"]), 3),
