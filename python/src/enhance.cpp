@@ -169,6 +169,14 @@ void register_enhance(py::module_& m) {
         "vertexflow.enhance's work: options is {keyword: value} of the keywords given.");
   m.def("_enhance_options", &py_enhance_options, py::arg("options"), py::arg("has_reference") = false,
         py::arg("naming") = "python", "vertexflow.enhance_options's work.");
+  m.def(
+      "_estimated_enhance_peak_bytes",
+      [](Index vertices, bool block_jacobi_alone) {
+        return estimated_enhance_peak_bytes(vertices, false, 0,
+                                            block_jacobi_alone ? LinearSolver::Iterative : LinearSolver::Automatic);
+      },
+      py::arg("vertices"), py::arg("block_jacobi_alone") = false,
+      "memory.h's estimate of enhance's peak on a mesh of `vertices` (bytes), for the tests of the refusal.");
   m.def("_time_vertex_flow", &py_time_enhance, py::arg("V"), py::arg("F"), py::arg("repeats") = 1,
         py::arg("threads") = 0,
         "Seconds of each of `repeats` calls of the enhance engine made from C++, as vertexflow.enhance(V, F) makes "

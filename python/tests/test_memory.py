@@ -40,10 +40,10 @@ if mesh.startswith("grid"):
 else:
     V, F = vertexflow.read_mesh(mesh)
 if headroom == 0:
-    # Between the two paths' estimates (src/common/memory_estimate.cpp: 176 MiB plus 680 B per
-    # vertex with the multilevel preconditioner, 650 without), less what this process holds already.
-    estimate = lambda per_vertex: 176 * 2**20 + per_vertex * len(V)
-    headroom = (estimate(680) + estimate(650)) // 2 - status_bytes("VmRSS")
+    # Between the two paths' estimates (vertexflow/memory.h; the library's own function, not a copy
+    # of its constants), less what this process holds already.
+    estimate = lambda block_jacobi_alone: vertexflow._core._estimated_enhance_peak_bytes(len(V), block_jacobi_alone)
+    headroom = (estimate(False) + estimate(True)) // 2 - status_bytes("VmRSS")
 limit = status_bytes("VmSize") + headroom
 resource.setrlimit(resource.RLIMIT_AS, (limit, resource.getrlimit(resource.RLIMIT_AS)[1]))
 try:
