@@ -24,6 +24,22 @@ void parallel_vertices(Index n, Body&& body) {
   });
 }
 
+// Sorts a vertex's list: by insertion for the usual dozen neighbours, where std::sort's set-up
+// cost more than the sorting (bench_topology), and by std::sort for a fan's thousands.
+void sort_small(std::vector<Index>& list) {
+  constexpr std::size_t kInsertionUpTo = 32;
+  if (list.size() > kInsertionUpTo) {
+    std::sort(list.begin(), list.end());
+    return;
+  }
+  for (std::size_t i = 1; i < list.size(); ++i) {
+    const Index x = list[i];
+    std::size_t j = i;
+    for (; j > 0 && list[j - 1] > x; --j) list[j] = list[j - 1];
+    list[j] = x;
+  }
+}
+
 // Exclusive prefix sum of counts into offsets (size n + 1).
 std::vector<Index> offsets_from_counts(const std::vector<Index>& counts) {
   std::vector<Index> offsets(counts.size() + 1, 0);
@@ -206,12 +222,19 @@ Topology build_topology(const Faces& F, Index num_vertices) {
       throw std::invalid_argument("build_topology: face " + std::to_string(f) + " repeats a vertex");
   }
 
-  // Vertex -> faces (counting sort, faces in increasing order per vertex).
+  // Vertex -> faces (counting sort, faces in increasing order per vertex), counted and placed
+  // by two threads over the two halves of the faces: the same lists as one serial pass.
   {
-    KeyBuckets<Index, Index> faces = bucket_by_key<Index, Index>(static_cast<std::size_t>(nv), [&](auto&& emit) {
-      for (Index f = 0; f < nf; ++f)
-        for (int k = 0; k < 3; ++k) emit(static_cast<std::size_t>(F(f, k)), f);
-    });
+    constexpr std::size_t kChunks = 2;
+    KeyBuckets<Index, Index> faces =
+        bucket_by_key_in_chunks<Index, Index>(static_cast<std::size_t>(nv), kChunks, [&](std::size_t c, auto&& emit) {
+          const Index first =
+              static_cast<Index>(static_cast<std::int64_t>(nf) * static_cast<std::int64_t>(c) / kChunks);
+          const Index last =
+              static_cast<Index>(static_cast<std::int64_t>(nf) * static_cast<std::int64_t>(c + 1) / kChunks);
+          for (Index f = first; f < last; ++f)
+            for (int k = 0; k < 3; ++k) emit(static_cast<std::size_t>(F(f, k)), f);
+        });
     t.face_offsets = std::move(faces.start);
     t.vertex_faces = std::move(faces.items);
   }
@@ -229,7 +252,7 @@ Topology build_topology(const Faces& F, Index num_vertices) {
         if (F(*f, k) > v) out.push_back(F(*f, k));
       }
     }
-    std::sort(out.begin(), out.end());
+    sort_small(out);
     out.erase(std::unique(out.begin(), out.end()), out.end());
   };
   // Each vertex's list is computed once into a scratch area sized by its corner count (a
@@ -270,69 +293,63 @@ Topology build_topology(const Faces& F, Index num_vertices) {
     return low;  // every face edge was recorded above, so this is it
   };
 
-  // Face -> edges, edge -> faces.
+  // Face -> edges, edge -> faces and face -> faces in one pass over each edge's owner (its
+  // smaller vertex): it meets each face edge it owns through its incident faces, which are in
+  // face order here, so an edge's first two faces are in face order, and no other vertex writes
+  // the owner's edges or their face slots.
   t.face_edges.resize(nf, 3);
-  tbb::parallel_for(tbb::blocked_range<Index>(0, nf, 4096), [&](const tbb::blocked_range<Index>& r) {
-    for (Index f = r.begin(); f != r.end(); ++f) {
-      for (int k = 0; k < 3; ++k) t.face_edges(f, k) = find_edge(F(f, k), F(f, (k + 1) % 3));
-    }
-  });
-  // Each edge's face count and first two faces in face order, filled by the edge's owner (its
-  // smaller vertex) from its incident faces, which are in face order here: the faces of the
-  // serial loop over faces, on all threads, and no one else writes the owner's edges.
-  t.edge_face_count.assign(static_cast<std::size_t>(ne), 0);
-  auto edge_face = std::make_unique_for_overwrite<Index[]>(2 * static_cast<std::size_t>(ne));
-  parallel_vertices(nv, [&](Index a, std::vector<Index>&) {
-    for (Index e = edge_offsets[static_cast<std::size_t>(a)]; e < edge_offsets[static_cast<std::size_t>(a) + 1]; ++e)
-      edge_face[2 * static_cast<std::size_t>(e)] = edge_face[2 * static_cast<std::size_t>(e) + 1] = -1;
-    const auto [begin, end] = incident_faces(a);
-    for (const Index* f = begin; f != end; ++f)
-      for (int k = 0; k < 3; ++k) {
-        if (F(*f, k) <= a) continue;
-        const auto e = static_cast<std::size_t>(find_edge(a, F(*f, k)));
-        const Index seen = t.edge_face_count[e]++;
-        if (seen < 2) edge_face[2 * e + static_cast<std::size_t>(seen)] = *f;
-      }
-  });
   t.face_adjacency.resize(nf, 3);
+  t.edge_face_count.assign(static_cast<std::size_t>(ne), 0);
   std::atomic<bool> oriented{true};
-  tbb::parallel_for(tbb::blocked_range<Index>(0, nf, 8192), [&](const tbb::blocked_range<Index>& r) {
-    for (Index f = r.begin(); f != r.end(); ++f) {
-      for (int k = 0; k < 3; ++k) {
-        const auto e = static_cast<std::size_t>(t.face_edges(f, k));
-        Index other = -1;
-        if (t.edge_face_count[e] == 2) {
-          other = edge_face[2 * e] == f ? edge_face[2 * e + 1] : edge_face[2 * e];
-          // Consistent orientation: the neighbour runs the shared edge the other way.
-          const Index a = F(f, k), b = F(f, (k + 1) % 3);
-          for (int j = 0; j < 3; ++j) {
-            if (F(other, j) == a && F(other, (j + 1) % 3) == b) oriented.store(false, std::memory_order_relaxed);
-          }
-        }
-        t.face_adjacency(f, k) = other;
+  parallel_vertices(nv, [&](Index a, std::vector<Index>& sides) {
+    const Index first_edge = edge_offsets[static_cast<std::size_t>(a)];
+    const Index owned = edge_offsets[static_cast<std::size_t>(a) + 1] - first_edge;
+    sides.assign(2 * static_cast<std::size_t>(owned), -1);  // each edge's first two sides, 3 face + slot
+    const auto [begin, end] = incident_faces(a);
+    for (const Index* f = begin; f != end; ++f) {
+      const int j = F(*f, 0) == a ? 0 : F(*f, 1) == a ? 1 : 2;
+      for (const int k : {(j + 1) % 3, (j + 2) % 3}) {
+        if (F(*f, k) <= a) continue;
+        // Slot j is the edge a -> F(f, j + 1); slot k = j + 2 the edge F(f, k) -> a.
+        const int slot = k == (j + 1) % 3 ? j : k;
+        const Index e = find_edge(a, F(*f, k));
+        t.face_edges(*f, slot) = e;
+        t.face_adjacency(*f, slot) = -1;
+        const Index seen = t.edge_face_count[static_cast<std::size_t>(e)]++;
+        if (seen < 2)
+          sides[2 * static_cast<std::size_t>(e - first_edge) + static_cast<std::size_t>(seen)] = 3 * *f + slot;
       }
+    }
+    for (Index i = 0; i < owned; ++i) {
+      if (t.edge_face_count[static_cast<std::size_t>(first_edge + i)] != 2) continue;
+      const Index side0 = sides[2 * static_cast<std::size_t>(i)], side1 = sides[2 * static_cast<std::size_t>(i) + 1];
+      const Index f0 = side0 / 3, f1 = side1 / 3;
+      const int k0 = side0 % 3, k1 = side1 % 3;
+      t.face_adjacency(f0, k0) = f1;
+      t.face_adjacency(f1, k1) = f0;
+      // Consistent orientation: the two faces run the shared edge opposite ways.
+      if (F(f0, k0) == F(f1, k1)) oriented.store(false, std::memory_order_relaxed);
     }
   });
   t.is_oriented = oriented.load();
-  for (Index e = 0; e < ne; ++e) {
-    if (t.edge_face_count[static_cast<std::size_t>(e)] > 2) t.non_manifold_edges.push_back(e);
-  }
 
-  // One-rings: valence is the number of incident edges.
-  {
-    std::vector<Index> valence(static_cast<std::size_t>(nv), 0);
-    for (Index e = 0; e < ne; ++e)
-      ++valence[static_cast<std::size_t>(t.edges(e, 0))], ++valence[static_cast<std::size_t>(t.edges(e, 1))];
-    t.ring_offsets = offsets_from_counts(valence);
+  // Each edge once, in order: the non-manifold edges, the boundary vertices, and the one-rings'
+  // sizes (valence, the number of incident edges: a vertex's own edges, then one for each edge
+  // it is the larger end of).
+  std::vector<Index> valence = std::move(edge_counts);
+  t.is_boundary_vertex.assign(static_cast<std::size_t>(nv), 0);
+  bool has_boundary = false;
+  for (Index e = 0; e < ne; ++e) {
+    const Index count = t.edge_face_count[static_cast<std::size_t>(e)];
+    const auto a = static_cast<std::size_t>(t.edges(e, 0)), b = static_cast<std::size_t>(t.edges(e, 1));
+    ++valence[b];
+    if (count > 2) t.non_manifold_edges.push_back(e);
+    if (count == 1) t.is_boundary_vertex[a] = t.is_boundary_vertex[b] = 1, has_boundary = true;
   }
+  t.ring_offsets = offsets_from_counts(valence);
+  std::vector<Index>().swap(valence);
   t.ring_vertices.resize(static_cast<std::size_t>(t.ring_offsets.back()));
   t.is_manifold_vertex.assign(static_cast<std::size_t>(nv), 1);
-  t.is_boundary_vertex.assign(static_cast<std::size_t>(nv), 0);
-  for (Index e = 0; e < ne; ++e) {
-    if (t.edge_face_count[static_cast<std::size_t>(e)] == 1)
-      t.is_boundary_vertex[static_cast<std::size_t>(t.edges(e, 0))] =
-          t.is_boundary_vertex[static_cast<std::size_t>(t.edges(e, 1))] = 1;
-  }
   parallel_vertices(nv, [&](Index v, std::vector<Index>& scratch) {
     Index* ring = t.ring_vertices.data() + t.ring_offsets[static_cast<std::size_t>(v)];
     const Index ring_size =
@@ -363,7 +380,7 @@ Topology build_topology(const Faces& F, Index num_vertices) {
   }
 
   // Boundary loops: walk boundary half-edges (face edges reversed) from vertex to vertex.
-  {
+  if (has_boundary) {
     std::vector<Index> out_count(static_cast<std::size_t>(nv), 0);
     std::vector<std::pair<Index, Index>> half_edges;  // (from, to), reversed face order
     for (Index f = 0; f < nf; ++f) {
