@@ -48,16 +48,6 @@ void check_curvature(const Mesh& mesh, MeshRole role, const Curvature* curvature
                                 std::to_string(mesh.num_vertices()));
 }
 
-// The surface's own values at its own vertices (no interpolation needed).
-SurfaceCurvatureAtPoints own_curvature(const Curvature& c) {
-  SurfaceCurvatureAtPoints out;
-  out.tensors.resize(static_cast<std::size_t>(c.k1.size()));
-  parallel_for_index(static_cast<Index>(c.k1.size()),
-                     [&](Index i) { out.tensors[static_cast<std::size_t>(i)] = c.absolute_tensor(i); });
-  out.magnitude = c.absolute_sum();
-  return out;
-}
-
 }  // namespace
 
 Topology checked_topology(const Mesh& mesh, MeshRole role) {
@@ -222,7 +212,9 @@ MeshComparison compare_meshes(const Mesh& result, const Mesh& input, const Mesh*
   } else {
     uniformity(result, result_topology, surface_curvature_at(result.V, *query, input_curvature), c.edge_error_result,
                c.redistribution_rho_result);
-    uniformity(input, input_topology, own_curvature(input_curvature), c.edge_error_input, c.redistribution_rho_input);
+    // The input's own curvature at its own vertices: no interpolation, and no tensors stored.
+    c.edge_error_input = edge_error_stats(input.V, input_topology, input_curvature);
+    c.redistribution_rho_input = redistribution_rho(input_curvature.absolute_sum(), input.V, input.F);
   }
   query.reset();
 

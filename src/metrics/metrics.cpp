@@ -98,18 +98,11 @@ double redistribution_rho(const Eigen::VectorXd& surface_curvature, const Vertic
   return spearman_correlation(surface_curvature, vertex_density(V, F));
 }
 
-EdgeErrorStats edge_error_stats(const Vertices& V, const Topology& topology, const Curvature& surface) {
-  std::vector<Eigen::Matrix3d> tensors(static_cast<std::size_t>(surface.k1.size()));
-  parallel_for_index(static_cast<Index>(surface.k1.size()),
-                     [&](Index i) { tensors[static_cast<std::size_t>(i)] = surface.absolute_tensor(i); });
-  return edge_error_stats(V, topology, tensors);
-}
+namespace {
 
-EdgeErrorStats edge_error_stats(const Vertices& V, const Topology& topology,
-                                const std::vector<Eigen::Matrix3d>& surface_tensors) {
-  if (surface_tensors.size() != static_cast<std::size_t>(V.rows()))
-    throw std::invalid_argument("edge_error_stats: " + std::to_string(surface_tensors.size()) + " tensors for " +
-                                std::to_string(V.rows()) + " vertices");
+// edge_error_stats with vertex i's tensor K_i = tensor(i).
+template <class TensorOf>
+EdgeErrorStats edge_error_stats_of(const Vertices& V, const Topology& topology, TensorOf&& tensor) {
   EdgeErrorStats stats;
   const Index ne = topology.num_edges();
   if (ne == 0) return stats;
@@ -119,8 +112,7 @@ EdgeErrorStats edge_error_stats(const Vertices& V, const Topology& topology,
     const Index i = topology.edges(e, 0), j = topology.edges(e, 1);
     const Eigen::Vector3d d = (V.row(j) - V.row(i)).transpose();
     // Eq. 2-4 (f_em = the mean of both endpoints' quadratic forms), divided by 8 (docs/metrics.md).
-    const double f_em = 0.5 * (d.dot(surface_tensors[static_cast<std::size_t>(i)] * d) +
-                               d.dot(surface_tensors[static_cast<std::size_t>(j)] * d));
+    const double f_em = 0.5 * (d.dot(tensor(i) * d) + d.dot(tensor(j) * d));
     delta[e] = f_em / 8.0;
   });
   stats.mean = delta.mean();
@@ -129,6 +121,28 @@ EdgeErrorStats edge_error_stats(const Vertices& V, const Topology& topology,
     stats.coefficient_of_variation = std::sqrt((delta.array() - stats.mean).square().mean()) / stats.mean;
   }
   return stats;
+}
+
+void check_count(std::size_t tensors, const Vertices& V) {
+  if (tensors != static_cast<std::size_t>(V.rows()))
+    throw std::invalid_argument("edge_error_stats: " + std::to_string(tensors) + " tensors for " +
+                                std::to_string(V.rows()) + " vertices");
+}
+
+}  // namespace
+
+EdgeErrorStats edge_error_stats(const Vertices& V, const Topology& topology, const Curvature& surface) {
+  check_count(static_cast<std::size_t>(surface.k1.size()), V);
+  // Each K_i computed where an edge needs it rather than stored: the same values, without 72
+  // bytes per vertex (700 MB at 10M vertices, each page a fault on a VM, docs/benchmarks.md).
+  return edge_error_stats_of(V, topology, [&](Index i) { return surface.absolute_tensor(i); });
+}
+
+EdgeErrorStats edge_error_stats(const Vertices& V, const Topology& topology,
+                                const std::vector<Eigen::Matrix3d>& surface_tensors) {
+  check_count(surface_tensors.size(), V);
+  return edge_error_stats_of(
+      V, topology, [&](Index i) -> const Eigen::Matrix3d& { return surface_tensors[static_cast<std::size_t>(i)]; });
 }
 
 }  // namespace vertexflow
