@@ -48,7 +48,12 @@ std::vector<Eigen::Matrix3d> sliver_stiffness(const Vertices& X, const Faces& F,
 }  // namespace
 
 Vertices normalised(const Vertices& V, const FlowSetup& setup) {
-  return (V.rowwise() - setup.centroid) / setup.scale;
+  // Row by row on all threads, each the same expression: the result's 24 bytes per vertex are
+  // first touched by both (the page faults were most of this copy's 0.6 s at 10M vertices).
+  Vertices out(V.rows(), 3);
+  parallel_for_index(static_cast<Index>(V.rows()),
+                     [&](Index i) { out.row(i) = (V.row(i) - setup.centroid) / setup.scale; });
+  return out;
 }
 
 FlowSetup prepare_flow(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options) {

@@ -1,5 +1,6 @@
 // Feature detection of the flow's projection (src/flow/surface_projection.h): which sharp edges
 // are creases, which vertices are corners.
+#include "shapes.h"
 #include "test_support.h"
 #include "vertexflow/features.h"
 
@@ -69,6 +70,24 @@ TEST(FeatureDetection, AFoldThatFadesOutInsideThePlateIsNotACrease) {
   EXPECT_EQ(sharp_edges(features), 0);
   EXPECT_EQ(count(features, SurfaceFeatures::Kind::Smooth), mesh.num_vertices());
   EXPECT_EQ(*std::max_element(features.face_patch.begin(), features.face_patch.end()), 0);
+}
+
+TEST(FeatureDetection, WithoutSharpEdgesEachConnectedPieceIsOnePatch) {
+  // A smooth sphere is one patch; two spheres side by side are two, numbered by their lowest
+  // face (the flood fill's order), whatever their vertices' order.
+  const Mesh sphere = test::icosphere(1.0, 2);
+  const SurfaceFeatures one = features_of(sphere);
+  EXPECT_EQ(sharp_edges(one), 0);
+  EXPECT_TRUE(std::all_of(one.face_patch.begin(), one.face_patch.end(), [](Index p) { return p == 0; }));
+  Mesh two;
+  two.V.resize(2 * sphere.num_vertices(), 3);
+  two.V << sphere.V, sphere.V.rowwise() + Eigen::RowVector3d(3, 0, 0);
+  two.F.resize(2 * sphere.num_faces(), 3);
+  two.F << sphere.F.array() + sphere.num_vertices(), sphere.F;  // the second sphere's faces first
+  const SurfaceFeatures pieces = features_of(two);
+  EXPECT_EQ(sharp_edges(pieces), 0);
+  for (Index f = 0; f < two.num_faces(); ++f)
+    ASSERT_EQ(pieces.face_patch[static_cast<std::size_t>(f)], f < sphere.num_faces() ? 0 : 1) << "face " << f;
 }
 
 TEST(FeatureDetection, ScannedBunnyHasFewCornersAndCadPartsKeepTheirs) {
