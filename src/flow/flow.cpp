@@ -8,6 +8,8 @@
 #include "flow_setup.h"
 #include "flow_solver.h"
 #include "surface_projection.h"
+
+#include "numerics/parallel.h"
 #include "vertexflow/curvature.h"
 #include "vertexflow/distance.h"
 #include "vertexflow/manifold_split.h"
@@ -181,7 +183,7 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
   report.fixed_vertices = static_cast<Index>(std::count(fixed.begin(), fixed.end(), 1));
   report.mean_edge_length = setup.mean_edge_length;
 
-  Vertices X = input;
+  Vertices X = copy_rows_in_parallel(input);
   // One solver for all rounds: the connectivity is fixed, so its ordering is computed once.
   FlowSystemSolver solver(topology, fixed, options.solver, options.solver_tolerance);
   // Computed at the first guard, after the first solve: 16 bytes per vertex fewer at its peak.
@@ -299,7 +301,7 @@ FlowResult flow_rounds(const Vertices& V, const Faces& F, const Topology& topolo
   if (report.flat && X == input)
     result.V = V;
   else
-    result.V = (X * setup.scale).rowwise() + setup.centroid;
+    result.V = denormalised(X, setup);
   // Fixed vertices are returned bit for bit.
   for (Index i = 0; i < n; ++i) {
     if (fixed[static_cast<std::size_t>(i)]) result.V.row(i) = V.row(i);

@@ -47,6 +47,13 @@ std::vector<Eigen::Matrix3d> sliver_stiffness(const Vertices& X, const Faces& F,
 
 }  // namespace
 
+Vertices denormalised(const Vertices& X, const FlowSetup& setup) {
+  Vertices out(X.rows(), 3);
+  parallel_for_index(static_cast<Index>(X.rows()),
+                     [&](Index i) { out.row(i) = (X.row(i) * setup.scale) + setup.centroid; });
+  return out;
+}
+
 Vertices normalised(const Vertices& V, const FlowSetup& setup) {
   // Row by row on all threads, each the same expression: the result's 24 bytes per vertex are
   // first touched by both (the page faults were most of this copy's 0.6 s at 10M vertices).
@@ -105,7 +112,7 @@ void restore_after_solve(FlowSetup& setup, const Vertices& V, const Faces& F) {
 FlowFrame flow_frame(const Vertices& X, const Faces& F, const Topology& topology, const FlowOptions& options,
                      const std::vector<Index>& sliver_faces) {
   FlowFrame frame;
-  frame.P = X;
+  frame.P = copy_rows_in_parallel(X);
   frame.curvature = principal_curvatures(X, F, topology, options.curvature);
   frame.d = robust_radius(frame.curvature, options.d_percentile);
   if (!sliver_faces.empty())

@@ -37,9 +37,11 @@ struct FlowSetup {
 FlowSetup prepare_flow(const Vertices& V, const Faces& F, const Topology& topology, const FlowOptions& options);
 
 /// Points in the flow's normalised units (flow.h, "Scale and rigid motion"): (V - centroid) /
-/// scale. The one place the normalisation is written, so that restoring the input gives its
-/// bytes and the reference is normalised as the input is.
+/// scale. With denormalised, the result's way back (X scale + centroid), the one place the
+/// normalisation is written, so that restoring the input gives its bytes and the reference is
+/// normalised as the input is. Both write their rows on all threads (the same bytes).
 Vertices normalised(const Vertices& V, const FlowSetup& setup);
+Vertices denormalised(const Vertices& X, const FlowSetup& setup);
 
 /// detect_features without the vertex normals (empty): what prepare_flow needs.
 SurfaceFeatures detect_features_without_normals(const Vertices& V, const Faces& F, const Topology& topology,

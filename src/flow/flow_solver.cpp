@@ -355,7 +355,7 @@ Vertices FlowSystemSolver::solve(const FlowFrame& frame, FlowFrame* release, con
   residual -= b;
   const double b_norm = std::sqrt(deterministic_dot(b, b));
   report.solver_error = b_norm > 0 ? std::sqrt(deterministic_dot(residual, residual)) / b_norm : 0.0;
-  Vertices Y = frame.P;
+  Vertices Y = copy_rows_in_parallel(frame.P);
   add_from_local(terms, d, Y.data());
   report.seconds_solve += seconds_since(start);
   return Y;

@@ -30,6 +30,20 @@ void parallel_for_index(Index n, Body&& body, Index grain = 1024, Index serial_b
   });
 }
 
+/// A copy of V (the same bytes as `Vertices copy = V`) written by all threads in ranges of rows:
+/// a large copy made on one thread first touches all of its pages there, and on a VM that
+/// costs most of the copy's time (docs/benchmarks.md, "Fresh pages on this VM").
+inline Vertices copy_rows_in_parallel(const Vertices& V) {
+  Vertices out(V.rows(), V.cols());
+  const Index columns = static_cast<Index>(V.cols());
+  tbb::parallel_for(
+      tbb::blocked_range<Index>(0, static_cast<Index>(V.rows()), 16384), [&](const tbb::blocked_range<Index>& range) {
+        std::copy(V.data() + std::ptrdiff_t{range.begin()} * columns, V.data() + std::ptrdiff_t{range.end()} * columns,
+                  out.data() + std::ptrdiff_t{range.begin()} * columns);
+      });
+  return out;
+}
+
 /// The sum over the chunks [k chunk, min(n, (k + 1) chunk)) of chunk_sum(begin, end), the
 /// chunks computed in parallel and added in order, starting from `zero`. T is a double or an
 /// Eigen vector.
