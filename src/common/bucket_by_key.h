@@ -9,8 +9,10 @@
 
 #include <tbb/parallel_for.h>
 
+#include <algorithm>
 #include <cstddef>
 #include <span>
+#include <utility>
 #include <vector>
 
 namespace vertexflow {
@@ -42,6 +44,14 @@ KeyBuckets<Item, Offset> bucket_by_key(std::size_t num_keys, ForEach&& for_each)
   std::vector<Offset> fill(buckets.start.begin(), buckets.start.end() - 1);
   for_each([&](std::size_t key, const Item& item) { buckets.items[static_cast<std::size_t>(fill[key]++)] = item; });
   return buckets;
+}
+
+/// Items [first, last) of chunk `chunk` when n items are cut into num_chunks runs of
+/// ceil(n / num_chunks) (the last runs shorter or empty): how the callers of the two functions
+/// below cut their items.
+inline std::pair<std::size_t, std::size_t> chunk_range(std::size_t n, std::size_t num_chunks, std::size_t chunk) {
+  const std::size_t length = (n + num_chunks - 1) / num_chunks;
+  return {std::min(n, chunk * length), std::min(n, (chunk + 1) * length)};
 }
 
 /// The counting sort of bucket_by_key_in_chunks below, for a caller that stores the items

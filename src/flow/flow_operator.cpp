@@ -389,10 +389,10 @@ BlockSparseMatrix galerkin_upper(const FlowTerms& t, const AggregationCoarseSpac
     // The locals of each aggregate of the range, by vertex (a counting sort, so in vertex
     // order; in fixed chunks of the vertices, counted and placed on all threads).
     constexpr std::size_t kChunks = 8;
-    const std::size_t chunk = (m + kChunks - 1) / kChunks;
     touches = bucket_by_key_in_chunks<std::pair<std::uint32_t, std::uint32_t>>(
         a1 - a0, kChunks, [&](std::size_t part, auto&& emit) {
-          for (std::size_t c = part * chunk; c < std::min(m, (part + 1) * chunk); ++c)
+          const auto [begin, end] = chunk_range(m, kChunks, part);
+          for (std::size_t c = begin; c < end; ++c)
             for (std::size_t k = local_start[c]; k < local_start[c + 1]; ++k) {
               const auto a = static_cast<std::size_t>(local_aggregate[k]);
               if (a >= a0 && a < a1)

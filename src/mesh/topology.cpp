@@ -40,6 +40,11 @@ void sort_small(std::vector<Index>& list) {
   }
 }
 
+// The corner (0, 1 or 2) of face f at vertex v, which the face has.
+int corner_of(const Faces& F, Index f, Index v) {
+  return F(f, 0) == v ? 0 : F(f, 1) == v ? 1 : 2;
+}
+
 // Exclusive prefix sum of counts into offsets (size n + 1).
 std::vector<Index> offsets_from_counts(const std::vector<Index>& counts) {
   std::vector<Index> offsets(counts.size() + 1, 0);
@@ -139,7 +144,7 @@ bool order_one_ring(Index v, const Faces& F, Index* faces, Index count, Index* r
   Index* b = a + count;
   for (Index w = 0; w < count; ++w) {
     const Index f = faces[w];
-    const int c = F(f, 0) == v ? 0 : F(f, 1) == v ? 1 : 2;
+    const int c = corner_of(F, f, v);
     a[w] = F(f, (c + 1) % 3), b[w] = F(f, (c + 2) % 3);
   }
   if (small) {
@@ -228,11 +233,8 @@ Topology build_topology(const Faces& F, Index num_vertices) {
     constexpr std::size_t kChunks = 2;
     KeyBuckets<Index, Index> faces =
         bucket_by_key_in_chunks<Index, Index>(static_cast<std::size_t>(nv), kChunks, [&](std::size_t c, auto&& emit) {
-          const Index first =
-              static_cast<Index>(static_cast<std::int64_t>(nf) * static_cast<std::int64_t>(c) / kChunks);
-          const Index last =
-              static_cast<Index>(static_cast<std::int64_t>(nf) * static_cast<std::int64_t>(c + 1) / kChunks);
-          for (Index f = first; f < last; ++f)
+          const auto [first, last] = chunk_range(static_cast<std::size_t>(nf), kChunks, c);
+          for (auto f = static_cast<Index>(first); f < static_cast<Index>(last); ++f)
             for (int k = 0; k < 3; ++k) emit(static_cast<std::size_t>(F(f, k)), f);
         });
     t.face_offsets = std::move(faces.start);
@@ -307,7 +309,7 @@ Topology build_topology(const Faces& F, Index num_vertices) {
     sides.assign(2 * static_cast<std::size_t>(owned), -1);  // each edge's first two sides, 3 face + slot
     const auto [begin, end] = incident_faces(a);
     for (const Index* f = begin; f != end; ++f) {
-      const int j = F(*f, 0) == a ? 0 : F(*f, 1) == a ? 1 : 2;
+      const int j = corner_of(F, *f, a);
       for (const int k : {(j + 1) % 3, (j + 2) % 3}) {
         if (F(*f, k) <= a) continue;
         // Slot j is the edge a -> F(f, j + 1); slot k = j + 2 the edge F(f, k) -> a.

@@ -48,7 +48,7 @@ void parallel_rows(int rows, Body&& body) {
 
 // Fixed chunks of rows for transpose below: the result does not depend on them, and four
 // keep the per-chunk column counts small (4 ints per column) while two threads share the work.
-constexpr int kTransposeChunks = 4;
+constexpr std::size_t kTransposeChunks = 4;
 
 // A^T: the blocks (r, c) of A, bucketed by column c in order of r (the places of the serial loop
 // over rows), written transposed. Counted and placed by fixed chunks of rows in parallel
@@ -59,12 +59,11 @@ BasicBlockSparseMatrix<Scalar> transpose(const BasicBlockSparseMatrix<Scalar>& A
   BasicBlockSparseMatrix<Scalar> T;
   T.rows = A.cols;
   T.cols = A.rows;
-  const int chunk_rows = (A.rows + kTransposeChunks - 1) / kTransposeChunks;
   T.start = place_by_key_in_chunks<int>(
       static_cast<std::size_t>(A.cols), kTransposeChunks,
       [&](std::size_t chunk, auto&& emit) {  // block m of row r as (r, m), keyed by its column
-        for (int r = static_cast<int>(chunk) * chunk_rows;
-             r < std::min(A.rows, (static_cast<int>(chunk) + 1) * chunk_rows); ++r)
+        const auto [first, last] = chunk_range(static_cast<std::size_t>(A.rows), kTransposeChunks, chunk);
+        for (auto r = static_cast<int>(first); r < static_cast<int>(last); ++r)
           for (int m = A.start[static_cast<std::size_t>(r)]; m < A.start[static_cast<std::size_t>(r) + 1]; ++m)
             emit(static_cast<std::size_t>(A.column[static_cast<std::size_t>(m)]), std::pair{r, m});
       },

@@ -48,16 +48,31 @@ TEST(BucketByKey, InChunksGivesTheSerialResult) {
       for (const auto& [key, payload] : items) emit(key, payload);
     });
     for (const std::size_t chunks : {1ul, 3ul, 8ul, 64ul}) {  // 64 > 7 items: empty chunks
-      const std::size_t chunk = (count + chunks - 1) / chunks;
       const KeyBuckets<int, std::uint32_t> chunked =
           bucket_by_key_in_chunks<int, std::uint32_t>(101, chunks, [&](std::size_t part, auto&& emit) {
-            for (std::size_t k = part * chunk; k < std::min(count, (part + 1) * chunk); ++k)
-              emit(items[k].first, items[k].second);
+            const auto [first, last] = chunk_range(count, chunks, part);
+            for (std::size_t k = first; k < last; ++k) emit(items[k].first, items[k].second);
           });
       EXPECT_EQ(chunked.start, serial.start) << count << " items in " << chunks << " chunks";
       EXPECT_EQ(chunked.items, serial.items) << count << " items in " << chunks << " chunks";
     }
   }
+}
+
+// The chunks cover [0, n) in order, each item once, and none is longer than ceil(n / chunks).
+TEST(BucketByKey, ChunkRangesTileTheItems) {
+  for (const std::size_t n : {0ul, 1ul, 7ul, 8ul, 5000ul})
+    for (const std::size_t chunks : {1ul, 2ul, 3ul, 8ul, 64ul}) {
+      std::size_t next = 0;
+      for (std::size_t c = 0; c < chunks; ++c) {
+        const auto [first, last] = chunk_range(n, chunks, c);
+        EXPECT_EQ(first, next) << n << " items, chunk " << c << " of " << chunks;
+        EXPECT_LE(first, last);
+        EXPECT_LE(last - first, (n + chunks - 1) / chunks);
+        next = last;
+      }
+      EXPECT_EQ(next, n) << n << " items in " << chunks << " chunks";
+    }
 }
 
 }  // namespace
