@@ -12,6 +12,8 @@
 // program or Python gets the same.
 #include "allocator.h"
 
+#include "page_pool.h"
+
 #include <string>
 
 #if defined(VERTEXFLOW_WITH_JEMALLOC)
@@ -19,14 +21,18 @@
 
 // jemalloc reads its options from this symbol when it starts (before main); MALLOC_CONF in the
 // environment still overrides them. thp:always advises huge pages on every mapping it makes;
-// metadata_thp:auto its own bookkeeping once that is large. dirty_decay_ms:1000 returns freed
-// pages after a second instead of ten: a phase still reuses its own, and what the previous phase
-// freed is not held through the next one's peak; retain:false unmaps what it returns instead of
-// keeping it for reuse (arm1m's peak 752 -> 734 MB at the same speed). Both measured against
-// the defaults in docs/benchmarks.md, "The allocator".
+// metadata_thp:auto its own bookkeeping once that is large; retain:false unmaps what it returns
+// instead of keeping the address range (arm1m's peak 752 -> 734 MB at the same speed; docs/
+// benchmarks.md, "The allocator"). What it returns goes to the page pool (page_pool.cpp), whose
+// pages serve any request of any arena, so jemalloc keeps nothing itself: dirty_decay_ms:0
+// returns freed extents at once (with a second's decay, as before the pool, they sat in the
+// arena while other requests mapped fresh pages: a 619k-vertex mesh peaked at 439 MB against 414
+// MB, at the same speed); narenas:1 puts every thread's requests in one arena that carries the
+// pool's hooks; oversize_threshold:0 turns off the separate arena for requests of 8 MiB and
+// more, which would keep jemalloc's own hooks (docs/benchmarks.md, "The page pool").
 extern "C" {
 // NOLINTNEXTLINE: the name and type are jemalloc's interface.
-const char* malloc_conf = "thp:always,metadata_thp:auto,dirty_decay_ms:1000,retain:false";
+const char* malloc_conf = "thp:always,metadata_thp:auto,dirty_decay_ms:0,retain:false,narenas:1,oversize_threshold:0";
 }
 #endif
 
@@ -41,7 +47,8 @@ std::string allocator_description() {
     return "jemalloc (version unknown)";
   size = sizeof(const char*);
   const bool has_thp = mallctl("opt.thp", static_cast<void*>(&thp), &size, nullptr, 0) == 0 && thp != nullptr;
-  return std::string("jemalloc ") + version + (has_thp ? std::string(", transparent huge pages: ") + thp : "");
+  return std::string("jemalloc ") + version + (has_thp ? std::string(", transparent huge pages: ") + thp : "") +
+         (page_pool_installed() ? ", page pool" : "");
 #else
   return "the C library's malloc";
 #endif

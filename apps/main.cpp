@@ -2,6 +2,7 @@
 // parses the command line and turns every error into one line on stderr and exit code 1.
 #include "allocator.h"
 #include "cli_common.h"
+#include "page_pool.h"
 
 #include <fmt/format.h>
 
@@ -23,6 +24,7 @@ std::string input_prefix() {
 
 int main(int argc, char** argv) {
   using namespace vertexflow::cli;
+  install_page_pool();
   CLI::App app{"vertexflow: enhance the shape features of triangle meshes by vertex flow"};
   app.require_subcommand(1);
   app.set_version_flag("--version", "vertexflow 0.1.0\nallocator: " + allocator_description());
@@ -63,5 +65,6 @@ int main(int argc, char** argv) {
     fmt::print(stderr, "vertexflow: error: {}{}\n", names_an_input(e.what()) ? "" : input_prefix(), e.what());
     return 1;
   }
+  print_page_pool_stats();
   return 0;
 }
