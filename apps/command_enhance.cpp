@@ -199,16 +199,19 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     // One line now rather than the OOM killer later, or block-Jacobi alone where only the
     // multilevel preconditioner would not fit (vertexflow/memory.h).
     const EnhanceMemoryPlan memory_plan =
-        plan_memory_for_enhance(o->input, mesh.num_vertices(), !o->report_file.empty() || !o->html_file.empty(),
+        plan_memory_for_enhance(o->input, mesh.num_vertices(), measured,
                                 reference ? static_cast<Index>(reference->vertices().rows()) : 0, options.flow.solver);
     options.flow.solver = memory_plan.solver;
     if (!memory_plan.note.empty()) callbacks.warning(memory_plan.note);
     // Trees over the reference's faces that the run and its report build (reference_surface.h).
     const std::uint64_t trees_before = reference ? distance_trees_built(reference->faces().rows()) : 0;
     EnhanceResult result;
+    // What the report's metrics can take from the run instead of building it again.
+    EnhanceMetricsReuse reuse;
     try {
       const ProgressPart engine("", part[2], part[3]);
-      result = enhance(mesh, reference_pointer, options, callbacks);
+      result = measured ? enhance(mesh, reference_pointer, options, callbacks, reuse)
+                        : enhance(mesh, reference_pointer, options, callbacks);
     } catch (const std::invalid_argument& e) {
       throw std::runtime_error(o->input + ": " + e.what());
     }
@@ -230,8 +233,9 @@ void register_enhance_command(CLI::App& app, const GlobalOptions& global) {
     EnhanceCurvatures curvatures;
     nlohmann::json report = [&] {
       const ProgressPart metrics("metrics", part[4], part[5]);
-      return enhance_metrics(mesh, out, reference_pointer, &curvatures);
+      return enhance_metrics(mesh, out, reference_pointer, &curvatures, &reuse);
     }();
+    reuse.clear();
     report.update(result.report);
     report["seconds"]["read"] = seconds_read;
     report["seconds"]["write"] = seconds_write;

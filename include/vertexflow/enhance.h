@@ -29,6 +29,7 @@
 #include <nlohmann/json.hpp>
 
 #include <functional>
+#include <memory>
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -199,6 +200,36 @@ void check_reference_fits(const Mesh& mesh, const ReferenceSurface& reference);
 EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const EnhanceOptions& options,
                       const EnhanceCallbacks& callbacks = {});
 
+/// What an enhance run keeps for enhance_metrics on the same input, so that the metrics do not
+/// build it again: the input's topology as the flow left it (flow.h: the parts only its set-up
+/// reads are released), about 140 bytes per vertex, when the flow ran on all of the input's faces
+/// (no face held out, no seam welded, no attributes); otherwise nothing. At 9.7M vertices the
+/// report's metrics built it in 3-4.5 s (docs/benchmarks.md). Opaque: only enhance_metrics reads
+/// it, and only for the mesh it was kept for (its faces are checked).
+class EnhanceMetricsReuse {
+ public:
+  EnhanceMetricsReuse();
+  ~EnhanceMetricsReuse();
+  EnhanceMetricsReuse(EnhanceMetricsReuse&&) noexcept;
+  EnhanceMetricsReuse& operator=(EnhanceMetricsReuse&&) noexcept;
+  /// Whether the run kept anything.
+  [[nodiscard]] bool empty() const;
+  /// Frees what is kept.
+  void clear();
+  /// What is kept, opaque: defined and read in the library only.
+  struct Kept;
+  [[nodiscard]] const Kept* kept() const { return kept_.get(); }
+  void keep(std::unique_ptr<Kept> kept);
+
+ private:
+  std::unique_ptr<Kept> kept_;
+};
+
+/// enhance(), keeping in `reuse` what enhance_metrics(mesh, ...) can take instead of computing
+/// it again (EnhanceMetricsReuse); `reuse` is cleared first. The result is enhance()'s.
+EnhanceResult enhance(const Mesh& mesh, const ReferenceSurface* reference, const EnhanceOptions& options,
+                      const EnhanceCallbacks& callbacks, EnhanceMetricsReuse& reuse);
+
 /// The metrics of docs/metrics.md for an enhance result against its input: counts, flipped and
 /// degenerate faces (flipped per face index when the faces differ, edge_flips.h), quality,
 /// displacement and drift in mean input edge lengths, redistribution rho, edge-error CV, |H|
@@ -210,7 +241,9 @@ struct EnhanceCurvatures {
   Curvature input;
   Curvature result;
 };
+/// `reuse`, when given, is what the run kept for this input (EnhanceMetricsReuse); kept data for
+/// another mesh (other faces) is ignored. The figures are the same bytes with or without it.
 nlohmann::json enhance_metrics(const Mesh& input, const Mesh& result, const ReferenceSurface* reference = nullptr,
-                               EnhanceCurvatures* curvatures = nullptr);
+                               EnhanceCurvatures* curvatures = nullptr, const EnhanceMetricsReuse* reuse = nullptr);
 
 }  // namespace vertexflow

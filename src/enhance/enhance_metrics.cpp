@@ -35,21 +35,30 @@ nlohmann::json distance_to(const Mesh& m, const ReferenceSurface& reference) {
 }  // namespace
 
 nlohmann::json enhance_metrics(const Mesh& input, const Mesh& result, const ReferenceSurface* reference,
-                               EnhanceCurvatures* curvatures_out) {
+                               EnhanceCurvatures* curvatures_out, const EnhanceMetricsReuse* reuse) {
+  // What the run kept for this input: its topology, over all of its faces, all of them workable.
+  const EnhanceMetricsReuse::Kept* kept = reuse ? reuse->kept() : nullptr;
+  if (kept && (kept->topology.num_vertices != input.num_vertices() || kept->topology.num_faces != input.num_faces() ||
+               kept->faces != enhance_detail::faces_fingerprint(input.F)))
+    kept = nullptr;
   // The faces enhance() held out (zero area, a repeated vertex, a duplicate) have no curvature,
   // quality or orientation to measure: the metrics are those of the others, on the same vertices.
-  const std::vector<Index> faces = enhance_detail::workable_faces(input);
-  if (faces.size() != static_cast<std::size_t>(input.num_faces()) && result.F.rows() == input.F.rows()) {
-    Mesh input_part, result_part;
-    input_part.V = input.V;
-    input_part.F = enhance_detail::face_rows(input.F, faces);
-    result_part.V = result.V;
-    result_part.F = enhance_detail::face_rows(result.F, faces);
-    return enhance_metrics(input_part, result_part, reference, curvatures_out);
+  if (!kept) {
+    const std::vector<Index> faces = enhance_detail::workable_faces(input);
+    if (faces.size() != static_cast<std::size_t>(input.num_faces()) && result.F.rows() == input.F.rows()) {
+      Mesh input_part, result_part;
+      input_part.V = input.V;
+      input_part.F = enhance_detail::face_rows(input.F, faces);
+      result_part.V = result.V;
+      result_part.F = enhance_detail::face_rows(result.F, faces);
+      return enhance_metrics(input_part, result_part, reference, curvatures_out);
+    }
   }
   // Progress (progress.h): at 1M vertices the two curvatures took about a fifth of the 8 s.
   report_progress("metrics: curvature", 0, 0.2);
-  const Topology topology = build_topology(input.F, input.num_vertices());
+  std::optional<Topology> built;
+  if (!kept) built = build_topology(input.F, input.num_vertices());
+  const Topology& topology = kept ? kept->topology : *built;
   // After edge flips the result has faces of its own (each keeping its index, edge_flips.h).
   const bool same_faces = result.F == input.F;
   std::optional<Topology> flipped;

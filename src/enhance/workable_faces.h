@@ -1,8 +1,12 @@
-// Internal to the enhance stage: the faces the methods and the metrics work on (enhance.h).
+// Internal to the enhance stage: the faces the methods and the metrics work on, and what a run
+// keeps for the metrics (enhance.h).
 #pragma once
 
+#include "vertexflow/enhance.h"
 #include "vertexflow/mesh.h"
+#include "vertexflow/topology.h"
 
+#include <cstdint>
 #include <vector>
 
 namespace vertexflow::enhance_detail {
@@ -14,4 +18,19 @@ std::vector<Index> workable_faces(const Mesh& mesh);
 /// `F`'s rows `faces`.
 Faces face_rows(const Faces& F, const std::vector<Index>& faces);
 
+/// A 64-bit fingerprint of a face list (its size and every index, in order).
+std::uint64_t faces_fingerprint(const Faces& F);
+
 }  // namespace vertexflow::enhance_detail
+
+namespace vertexflow {
+
+/// EnhanceMetricsReuse's content (enhance.h).
+struct EnhanceMetricsReuse::Kept {
+  /// build_topology(faces, vertices) of the input, as the flow left it (flow.h): every face of
+  /// the input workable, so the metrics' faces are these.
+  Topology topology;
+  std::uint64_t faces = 0;  ///< enhance_detail::faces_fingerprint of the input's F
+};
+
+}  // namespace vertexflow

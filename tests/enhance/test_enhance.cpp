@@ -243,6 +243,34 @@ TEST(Enhance, ResultsDoNotDependOnTheThreadCount) {
   }
 }
 
+// What a flow run keeps for its metrics (EnhanceMetricsReuse): the same figures as without it,
+// and ignored for another face list or a run that held faces out.
+TEST(EnhanceMetrics, WhatTheRunKeptGivesTheSameFiguresForItsOwnInputOnly) {
+  const Mesh mesh = read_mesh(test::data_path("bunny_uniform.off"));
+  EnhanceMetricsReuse reuse;
+  const EnhanceResult run = enhance(mesh, nullptr, EnhanceOptions{}, {}, reuse);
+  ASSERT_FALSE(reuse.empty());  // the flow ran on all of the input's faces
+  EXPECT_EQ(enhance_metrics(mesh, run.mesh, nullptr, nullptr, &reuse), enhance_metrics(mesh, run.mesh));
+
+  // The same vertices and faces in another order: the kept face lists no longer fit, so they
+  // must not be read.
+  Mesh reordered = mesh;
+  Mesh reordered_result = run.mesh;
+  for (Eigen::Index f = 0; f + 1 < mesh.F.rows(); f += 2) {
+    reordered.F.row(f).swap(reordered.F.row(f + 1));
+    reordered_result.F.row(f).swap(reordered_result.F.row(f + 1));
+  }
+  EXPECT_EQ(enhance_metrics(reordered, reordered_result, nullptr, nullptr, &reuse),
+            enhance_metrics(reordered, reordered_result));
+
+  // A duplicate face is held out of the methods (enhance.h): nothing is kept.
+  Mesh with_duplicate = mesh;
+  with_duplicate.F.conservativeResize(mesh.F.rows() + 1, 3);
+  with_duplicate.F.row(mesh.F.rows()) = mesh.F.row(0);
+  enhance(with_duplicate, nullptr, EnhanceOptions{}, {}, reuse);
+  EXPECT_TRUE(reuse.empty());
+}
+
 // Smooth mode holds an input whose comments record a fit (provenance.h), with one warning in
 // the result; assume_on_surface fits it anyway.
 TEST(Enhance, SmoothModeReadsTheInputsProvenance) {
