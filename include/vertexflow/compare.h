@@ -29,6 +29,7 @@
 #include "vertexflow/topology.h"
 
 #include <optional>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -74,10 +75,13 @@ struct SurfaceCurvatureAtPoints {
 };
 
 /// Interpolates `surface_curvature` (per vertex of the mesh behind `surface`) at the closest
-/// points of the rows of P. Throws std::invalid_argument if the curvature does not have one
-/// entry per vertex of that mesh.
+/// points of the rows of P. `near_faces`, empty or one per row of P, are guesses of a face of
+/// that mesh near each row's answer, -1 for none (DistanceQuery::closest_points): they make the
+/// search faster, not its answers different. Throws std::invalid_argument if the curvature does
+/// not have one entry per vertex of that mesh, or as closest_points does for the guesses.
 SurfaceCurvatureAtPoints surface_curvature_at(const Vertices& P, const DistanceQuery& surface,
-                                              const Curvature& surface_curvature);
+                                              const Curvature& surface_curvature,
+                                              std::span<const Index> near_faces = {});
 
 /// Everything metrics.md asks for (except the level-of-detail and timing figures).
 struct MeshComparison {

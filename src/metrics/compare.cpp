@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <optional>
 #include <string>
 
@@ -81,7 +82,7 @@ MeanCurvaturePercentiles mean_curvature_percentiles(const Curvature& curvature) 
 }
 
 SurfaceCurvatureAtPoints surface_curvature_at(const Vertices& P, const DistanceQuery& surface,
-                                              const Curvature& surface_curvature) {
+                                              const Curvature& surface_curvature, std::span<const Index> near_faces) {
   if (surface_curvature.k1.size() != surface.vertices().rows())
     throw std::invalid_argument("surface_curvature_at: curvature of " + std::to_string(surface_curvature.k1.size()) +
                                 " vertices for a surface of " + std::to_string(surface.vertices().rows()));
@@ -95,17 +96,25 @@ SurfaceCurvatureAtPoints surface_curvature_at(const Vertices& P, const DistanceQ
   // vertex order. The answers do not depend on the order (distance.h: equally close faces go to
   // the lowest-numbered). They are taken in chunks, so that they take 4 MiB rather than 64 bytes
   // per point.
+  if (!near_faces.empty() && static_cast<Eigen::Index>(near_faces.size()) != P.rows())
+    throw std::invalid_argument("surface_curvature_at: " + std::to_string(near_faces.size()) + " guesses for " +
+                                std::to_string(P.rows()) + " points");
   const std::vector<Index> order = space_filling_order(P);
   constexpr Eigen::Index kChunk = 65536;
   Vertices chunk;
+  std::vector<Index> chunk_near;
   for (Eigen::Index start = 0; start < P.rows(); start += kChunk) {
     const Eigen::Index n = std::min(kChunk, P.rows() - start);
     chunk.resize(n, 3);
+    if (!near_faces.empty()) chunk_near.resize(static_cast<std::size_t>(n));
     tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, n, 4096), [&](const auto& range) {
-      for (Eigen::Index i = range.begin(); i != range.end(); ++i)
-        chunk.row(i) = P.row(order[static_cast<std::size_t>(start + i)]);
+      for (Eigen::Index i = range.begin(); i != range.end(); ++i) {
+        const Index row = order[static_cast<std::size_t>(start + i)];
+        chunk.row(i) = P.row(row);
+        if (!near_faces.empty()) chunk_near[static_cast<std::size_t>(i)] = near_faces[static_cast<std::size_t>(row)];
+      }
     });
-    const std::vector<ClosestPoint> closest = surface.closest_points(chunk);
+    const std::vector<ClosestPoint> closest = surface.closest_points(chunk, chunk_near);
     tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, n, 4096), [&](const auto& range) {
       for (Eigen::Index i = range.begin(); i != range.end(); ++i) {
         const Index row = order[static_cast<std::size_t>(start + i)];
@@ -210,8 +219,29 @@ MeshComparison compare_meshes(const Mesh& result, const Mesh& input, const Mesh*
   if (reference) {
     reference_to_input = one_sided_distance(reference_samples, *query);
   } else {
-    uniformity(result, result_topology, surface_curvature_at(result.V, *query, input_curvature), c.edge_error_result,
-               c.redistribution_rho_result);
+    // With the input's connectivity, result vertex i is near input vertex i: of its faces, the
+    // one whose centroid is nearest is a good first guess for the search.
+    std::vector<Index> near_faces;
+    if (c.same_connectivity) {
+      near_faces.assign(static_cast<std::size_t>(result.V.rows()), -1);
+      parallel_for_index(static_cast<Index>(result.V.rows()), [&](Index v) {
+        const auto u = static_cast<std::size_t>(v);
+        double best = std::numeric_limits<double>::infinity();
+        for (auto k = static_cast<std::size_t>(input_topology.face_offsets[u]);
+             k < static_cast<std::size_t>(input_topology.face_offsets[u + 1]); ++k) {
+          const Index f = input_topology.vertex_faces[k];
+          const Eigen::RowVector3d centroid =
+              input.V.row(input.F(f, 0)) + input.V.row(input.F(f, 1)) + input.V.row(input.F(f, 2));
+          const double d = (centroid - 3 * result.V.row(v)).squaredNorm();
+          if (d < best) {
+            best = d;
+            near_faces[u] = f;
+          }
+        }
+      });
+    }
+    uniformity(result, result_topology, surface_curvature_at(result.V, *query, input_curvature, near_faces),
+               c.edge_error_result, c.redistribution_rho_result);
     // The input's own curvature at its own vertices: no interpolation, and no tensors stored.
     c.edge_error_input = edge_error_stats(input.V, input_topology, input_curvature);
     c.redistribution_rho_input = redistribution_rho(input_curvature.absolute_sum(), input.V, input.F);

@@ -4,6 +4,7 @@
 #include "test_support.h"
 
 #include "vertexflow/compare.h"
+#include "vertexflow/curvature.h"
 #include "vertexflow/flow.h"
 #include "vertexflow/io.h"
 
@@ -114,6 +115,29 @@ TEST(SurfaceCurvatureAt, InterpolatesLinearFieldsExactly) {
   }
   EXPECT_THROW(surface_curvature_at(P, DistanceQuery(square.V, square.F.topRows(1)), Curvature{}),
                std::invalid_argument);
+}
+
+// Guesses of a face near each point's answer change nothing but the search: good ones (a face
+// at the point's own vertex), poor ones (a face far away) and none, against no guesses at all.
+TEST(SurfaceCurvatureAt, GuessesGiveTheSameAnswers) {
+  const Mesh bunny = read_mesh(test::data_path("bunny_uniform.off"));
+  const Curvature k = principal_curvatures(bunny.V, bunny.F);
+  Vertices P = bunny.V;
+  for (Index i = 0; i < P.rows(); ++i)  // each vertex moved by up to 0.02 along each axis
+    P.row(i) += 0.02 * Eigen::RowVector3d(std::sin(3.0 * i), std::cos(5.0 * i), std::sin(7.0 * i));
+  const DistanceQuery surface(bunny.V, bunny.F);
+  const SurfaceCurvatureAtPoints plain = surface_curvature_at(P, surface, k);
+  std::vector<Index> guesses(static_cast<std::size_t>(P.rows()));
+  for (Index i = 0; i < P.rows(); ++i)
+    guesses[static_cast<std::size_t>(i)] = i % 3 == 0   ? -1
+                                           : i % 3 == 1 ? (i * 7919) % bunny.num_faces()
+                                                        : i % bunny.num_faces();
+  const SurfaceCurvatureAtPoints guessed = surface_curvature_at(P, surface, k, guesses);
+  EXPECT_EQ(plain.magnitude, guessed.magnitude);
+  ASSERT_EQ(plain.tensors.size(), guessed.tensors.size());
+  for (std::size_t i = 0; i < plain.tensors.size(); ++i) ASSERT_EQ(plain.tensors[i], guessed.tensors[i]) << i;
+  guesses.pop_back();
+  EXPECT_THROW(surface_curvature_at(P, surface, k, guesses), std::invalid_argument);
 }
 
 // The tensor overload of edge_error_stats is the Curvature overload with K_i spelled out, and
