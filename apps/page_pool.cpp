@@ -62,6 +62,18 @@ struct Pool {
   // Counters for VERTEXFLOW_PAGE_POOL_STATS.
   std::size_t reused_bytes = 0, fresh_bytes = 0, moves = 0;
   std::size_t debt = 0;  // fresh bytes mapped since the pool last gave pages back
+
+  // Removes at most `most` bytes (a multiple of kHugePage) from the top range and returns them.
+  // The caller holds the mutex and count > 0.
+  Range take(std::size_t most) {
+    Range& top = ranges[count - 1];
+    const Range taken{top.begin, std::min(most, top.bytes)};
+    top.begin += taken.bytes;
+    top.bytes -= taken.bytes;
+    pooled_bytes -= taken.bytes;
+    if (top.bytes == 0) --count;
+    return taken;
+  }
 };
 
 Pool& pool() {
@@ -115,14 +127,9 @@ void repay(Pool& p, std::size_t fresh) {
   }
   p.debt += fresh;
   while (p.debt >= kHugePage && p.count > 0) {
-    Pool::Range& r = p.ranges[p.count - 1];
-    const std::size_t take = std::min(align_down(p.debt, kHugePage), r.bytes);
-    unmap(r.begin, take);
-    r.begin += take;
-    r.bytes -= take;
-    p.pooled_bytes -= take;
-    if (r.bytes == 0) --p.count;
-    p.debt -= take;
+    const Pool::Range given = p.take(align_down(p.debt, kHugePage));
+    unmap(given.begin, given.bytes);
+    p.debt -= given.bytes;
   }
   if (p.count == 0) p.debt = 0;
 }
@@ -131,16 +138,18 @@ void* pool_alloc(extent_hooks_t*, void* new_addr, std::size_t size, std::size_t 
                  unsigned) {
   if (new_addr != nullptr) return nullptr;  // no growing in place: jemalloc maps elsewhere
   Pool& p = pool();
-  const std::size_t align = size >= kHugePage ? std::max<std::size_t>(alignment, kHugePage) : alignment;
-  std::uintptr_t begin = map_fresh(size, std::max<std::size_t>(align, 4096));
+  const std::size_t align =
+      std::max<std::size_t>(size >= kHugePage ? std::max<std::size_t>(alignment, kHugePage) : alignment, 4096);
+  std::uintptr_t begin = map_fresh(size, align);
   if (begin == 0) {
     // Out of address space (ulimit -v): the pooled ranges go back, then one more try.
     std::lock_guard<std::mutex> lock(p.mutex);
-    for (std::size_t i = 0; i < p.count; ++i) unmap(p.ranges[i].begin, p.ranges[i].bytes);
-    p.count = 0;
-    p.pooled_bytes = 0;
+    while (p.count > 0) {
+      const Pool::Range given = p.take(p.ranges[p.count - 1].bytes);
+      unmap(given.begin, given.bytes);
+    }
     p.debt = 0;
-    begin = map_fresh(size, std::max<std::size_t>(align, 4096));
+    begin = map_fresh(size, align);
     if (begin == 0) return nullptr;
   }
   *commit = true;
@@ -152,19 +161,14 @@ void* pool_alloc(extent_hooks_t*, void* new_addr, std::size_t size, std::size_t 
   std::uintptr_t to = begin;
   std::lock_guard<std::mutex> lock(p.mutex);
   while (need > 0 && p.count > 0) {
-    Pool::Range& r = p.ranges[p.count - 1];
-    const std::size_t take = std::min(need, r.bytes);
-    const std::uintptr_t from = r.begin;
-    r.begin += take;
-    r.bytes -= take;
-    p.pooled_bytes -= take;
-    if (r.bytes == 0) --p.count;
-    if (move_pages(from, take, to, p.moves)) p.reused_bytes += take;
-    to += take;
-    need -= take;
+    const Pool::Range moved = p.take(need);
+    if (move_pages(moved.begin, moved.bytes, to, p.moves)) p.reused_bytes += moved.bytes;
+    to += moved.bytes;
+    need -= moved.bytes;
   }
-  p.fresh_bytes += size - (to - begin);
-  repay(p, size - (to - begin));
+  const std::size_t fresh = size - (to - begin);
+  p.fresh_bytes += fresh;
+  repay(p, fresh);
   *zero = to == begin;  // moved pages hold what they held
   return reinterpret_cast<void*>(begin);
 }
