@@ -65,13 +65,29 @@ constexpr Index kDirectBelow = 1000;
 // n^1.5 s against ~2.5e-8 n s on 2 cores, so the ratio is about 18 sqrt(n)).
 constexpr double kBudgetPerSqrtVertex = 18.0;
 // LinearSolver::Automatic takes the multilevel preconditioner when a connected region of at
-// least kFlatRegionForMultilevel free vertices has |k1| + |k2| < kFlatCurvature (per mean edge
+// least kFlatRegionForMultilevel free vertices has |k1| + |k2| < kFlatCurvaturePerEdge (per mean edge
 // length): there F_em vanishes and block-Jacobi's iteration count grows like the region's
 // diameter squared. Measured (largest such region; block-Jacobi against multilevel
 // iterations): fandisk 1,257 vertices, 930 against 114; amo 4,825, 291 against 97; every other
 // data mesh at most 105 vertices. Starting multilevel at once saves the probe below.
-constexpr double kFlatCurvature = 0.01;
+constexpr double kFlatCurvaturePerEdge = 0.01;
 constexpr Index kFlatRegionForMultilevel = 500;
+// The multilevel path's hierarchy (AdditiveMultilevel, on the coarse problem) smooths its
+// prolongators only where a connected region of at least kPlanarRegionForSmoothing free
+// vertices is planar at the mesh's own scale: |k1| + |k2| < kPlanarCurvature / sqrt(n) per
+// mean edge length, n the vertex count (a sphere of n vertices has 7.7 / sqrt(n); sqrt(n) edge
+// lengths measure the surface however fine the mesh, and unlike a bounding box do not turn with
+// it). There the tangential stiffness is F_smo's bi-Laplacian, which the tentative prolongators
+// approximate badly; on curved surfaces the tentative ones took as few or fewer iterations and
+// a third less set-up. Measured (largest planar region; `--solver multilevel` iterations
+// smoothed against tentative, docs/benchmarks.md): fandisk split to 932k vertices 214,316, 155
+// / 344; chamfer-cube split to 141k 5,929, 114 / 255; fandisk 1,257, 54 / 68; against amo 297,
+// 48 / 37; the 10M armadillo (each edge split in three) under 490, 72 / 64 (set-up 15.7 / 11.6
+// s); rocker-arm split to 362k under 40, 56 / 40. The test of kFlatCurvaturePerEdge, relative
+// to the edge length, does not separate them: a finer mesh looks flatter, and the 10M
+// armadillo's largest region under it has 1,556 vertices.
+constexpr double kPlanarCurvature = 0.1;
+constexpr Index kPlanarRegionForSmoothing = 600;  // between 297 and 1,257, a factor of two from each
 // The iterations' products keep the operator's per-vertex caches in float (flow_operator.h: 48
 // bytes per vertex less at the solve's peak) where they stop at a relative residual of at least
 // this, 20 times those products' rounding (about 5e-8); tighter tolerances get exact products,
@@ -126,12 +142,13 @@ IterationResult run_reporting(ConjugateGradients& cg, int max_iterations, double
   return total;
 }
 
-// The size of the largest connected region of free vertices with |k1| + |k2| < kFlatCurvature.
-Index largest_flat_region(const FlowTerms& t) {
+// The size of the largest connected region of free vertices with |k1| + |k2| < flat (per mean
+// edge length).
+Index largest_flat_region(const FlowTerms& t, double flat) {
   const auto n = static_cast<std::size_t>(t.n);
   std::vector<char> open(n, 0);  // flat and not yet visited
   for (std::size_t i = 0; i < n; ++i) {
-    open[i] = !t.fixed[i] && t.K[i].trace() < kFlatCurvature;  // trace(K) = |k1| + |k2|
+    open[i] = !t.fixed[i] && t.K[i].trace() < flat;  // trace(K) = |k1| + |k2|
   }
   Index largest = 0;
   std::vector<Index> queue;
@@ -156,8 +173,9 @@ Index largest_flat_region(const FlowTerms& t) {
 // (degenerate input): block-Jacobi alone still converges, only more slowly.
 std::unique_ptr<CoarseSpaceCorrection> make_multilevel(const FlowTerms& terms) {
   try {
+    const AdditiveMultilevel::Prolongators prolongators = multilevel_prolongators(terms);
     auto space = std::make_shared<const AggregationCoarseSpace>(terms.ring_start, terms.ring, terms.fixed);
-    return std::make_unique<CoarseSpaceCorrection>(space, galerkin_upper(terms, *space));
+    return std::make_unique<CoarseSpaceCorrection>(space, galerkin_upper(terms, *space), prolongators);
   } catch (const std::runtime_error&) {
     return nullptr;
   }
@@ -175,6 +193,12 @@ std::vector<InverseFactor3f> block_jacobi(const FlowTerms& t) {
 }
 
 }  // namespace
+
+AdditiveMultilevel::Prolongators multilevel_prolongators(const FlowTerms& terms) {
+  const double planar = kPlanarCurvature / std::sqrt(static_cast<double>(std::max<Index>(terms.n, 1)));
+  return largest_flat_region(terms, planar) >= kPlanarRegionForSmoothing ? AdditiveMultilevel::Prolongators::Smoothed
+                                                                         : AdditiveMultilevel::Prolongators::Tentative;
+}
 
 struct FlowSystemSolver::Impl {
   const Topology& topology;
@@ -300,7 +324,8 @@ Vertices FlowSystemSolver::solve(const FlowFrame& frame, FlowFrame* release, con
     if (s.tolerance >= kFloatCachesFromTolerance) op.use_cache_precision(FlowOperator::CachePrecision::Float);
     std::unique_ptr<CoarseSpaceCorrection> multilevel;
     if (s.kind == LinearSolver::Multilevel ||
-        (s.kind == LinearSolver::Automatic && largest_flat_region(terms) >= kFlatRegionForMultilevel))
+        (s.kind == LinearSolver::Automatic &&
+         largest_flat_region(terms, kFlatCurvaturePerEdge) >= kFlatRegionForMultilevel))
       multilevel = make_multilevel(terms);
     ConjugateGradients cg(op, block_jacobi(terms), b, multilevel.get());
     report.seconds_factorization += seconds_since(start);

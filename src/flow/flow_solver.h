@@ -4,6 +4,8 @@
 // that LinearSolver chooses (flow.h; flow_solver.cpp has the policy and its calibration).
 #pragma once
 
+#include "flow_terms.h"
+#include "numerics/multigrid.h"
 #include "vertexflow/flow.h"
 #include "vertexflow/flow_energy.h"
 
@@ -45,6 +47,13 @@ class FlowSystemSolver {
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
+
+/// The prolongators of the multilevel path's hierarchy (multigrid.h) for the system of `terms`:
+/// Smoothed where a connected region of at least 600 free vertices is planar at the mesh's own
+/// scale (|k1| + |k2| below 0.1 / sqrt(n) per mean edge length, n vertices), else Tentative
+/// (flow_solver.cpp has the measurements). Invariant under rigid motion, uniform scale and
+/// renumbering, as the normalised terms are.
+AdditiveMultilevel::Prolongators multilevel_prolongators(const FlowTerms& terms);
 
 /// One solve with a temporary FlowSystemSolver.
 Vertices solve_flow_system(const Topology& topology, const FlowFrame& frame, const EnergyWeights& weights,

@@ -90,9 +90,11 @@ void AggregationCoarseSpace::restrict_to(const BlockVector& r, BlockVector& coar
 }
 
 CoarseSpaceCorrection::CoarseSpaceCorrection(std::shared_ptr<const AggregationCoarseSpace> space,
-                                             BlockSparseMatrix galerkin_upper)
+                                             BlockSparseMatrix galerkin_upper,
+                                             AdditiveMultilevel::Prolongators prolongators)
     : space_(std::move(space)),
-      coarse_(std::make_unique<AdditiveMultilevel>(std::move(galerkin_upper), AdditiveMultilevel::Storage::UpperHalf)) {
+      coarse_(std::make_unique<AdditiveMultilevel>(std::move(galerkin_upper), AdditiveMultilevel::Storage::UpperHalf,
+                                                   AdditiveMultilevel::kCoarsestUnknowns, prolongators)) {
   restricted_.resize(3 * space_->size());
 }
 

@@ -92,9 +92,11 @@ class AggregationCoarseSpace {
 /// The correction Phi M_c Phi^T of a coarse space and its Galerkin matrix.
 class CoarseSpaceCorrection : public PreconditionerCorrection {
  public:
-  /// `galerkin_upper`: the upper half (diagonal included) of Phi^T H Phi. Throws
-  /// std::runtime_error if its coarsest level is not numerically positive definite.
-  CoarseSpaceCorrection(std::shared_ptr<const AggregationCoarseSpace> space, BlockSparseMatrix galerkin_upper);
+  /// `galerkin_upper`: the upper half (diagonal included) of Phi^T H Phi; `prolongators`: those
+  /// of its hierarchy (multigrid.h). Throws std::runtime_error if its coarsest level is not
+  /// numerically positive definite.
+  CoarseSpaceCorrection(std::shared_ptr<const AggregationCoarseSpace> space, BlockSparseMatrix galerkin_upper,
+                        AdditiveMultilevel::Prolongators prolongators = AdditiveMultilevel::Prolongators::Smoothed);
   double add_to(const BlockVector& r, BlockVector& z) override;
 
  private:

@@ -201,6 +201,10 @@ BlockSparseMatrix smoothed_prolongator_of(const Rows& A, const std::vector<int>&
       return blocks.emplace_back(b, Matrix3::Zero()).second;
     };
     const auto own = aggregate[static_cast<std::size_t>(k)];
+    if (omega == 0) {  // the tentative prolongator: the loop below would add only zero blocks
+      row[own].diagonal().array() += scale[static_cast<std::size_t>(own)];
+      return;
+    }
     at(own).diagonal().array() += scale[static_cast<std::size_t>(own)];
     const Matrix3 damped = omega * block_inverse[static_cast<std::size_t>(k)];
     for_each_in_row(A, k, [&](int column, const Matrix3& block) {
@@ -509,7 +513,7 @@ struct CoarseLevel {
 };
 
 template <class Rows>
-std::optional<CoarseLevel> coarsen(const Rows& A) {
+std::optional<CoarseLevel> coarsen(const Rows& A, AdditiveMultilevel::Prolongators prolongators) {
   CoarseLevel level;
   int count = 0;
   {
@@ -518,11 +522,15 @@ std::optional<CoarseLevel> coarsen(const Rows& A) {
     const std::vector<int> aggregate =
         aggregate_nodes(start, neighbours, std::vector<char>(static_cast<std::size_t>(A.rows), 0), count);
     if (count == 0 || count > 0.8 * A.rows) return std::nullopt;  // coarsening stalled
-    // The tentative prolongator (the translations of each aggregate) smoothed by one damped
-    // block-Jacobi step, omega = 4 / (3 rho(B A)), the usual damping (it minimises the
-    // prolongator's energy for the highest modes), and truncated (kProlongatorTruncation).
+    // The tentative prolongator (the translations of each aggregate), unless asked for,
+    // smoothed by one damped block-Jacobi step, omega = 4 / (3 rho(B A)), the usual damping (it
+    // minimises the prolongator's energy for the highest modes), and truncated
+    // (kProlongatorTruncation). omega = 0 leaves the tentative one: the other aggregates'
+    // blocks are zero, and truncation drops them.
     level.block_inverse = block_diagonal_inverse(A);
-    const double omega = 4.0 / (3.0 * spectral_radius(level.block_inverse, A));
+    const double omega = prolongators == AdditiveMultilevel::Prolongators::Smoothed
+                             ? 4.0 / (3.0 * spectral_radius(level.block_inverse, A))
+                             : 0.0;
     level.P = rounded_to_float(
         smoothed_prolongator_of(A, aggregate, count, level.block_inverse, omega, kProlongatorTruncation));
   }
@@ -533,7 +541,8 @@ std::optional<CoarseLevel> coarsen(const Rows& A) {
 
 }  // namespace
 
-AdditiveMultilevel::AdditiveMultilevel(BlockSparseMatrix A, Storage storage, int coarsest_unknowns) {
+AdditiveMultilevel::AdditiveMultilevel(BlockSparseMatrix A, Storage storage, int coarsest_unknowns,
+                                       Prolongators prolongators) {
   if (A.rows != A.cols || A.start.size() != static_cast<std::size_t>(A.rows) + 1)
     throw std::invalid_argument("multilevel: the matrix must be square");
   auto add_level = [&](std::optional<CoarseLevel> next) {
@@ -545,10 +554,10 @@ AdditiveMultilevel::AdditiveMultilevel(BlockSparseMatrix A, Storage storage, int
   bool stalled = false;
   if (storage == Storage::UpperHalf) {
     // The first level from the upper half; the coarser ones, an eighth as large, whole.
-    if (3 * A.rows > coarsest_unknowns) stalled = !add_level(coarsen(UpperHalf(A)));
+    if (3 * A.rows > coarsest_unknowns) stalled = !add_level(coarsen(UpperHalf(A), prolongators));
     if (levels_.empty()) A = symmetric_from_upper(A);
   }
-  while (!stalled && 3 * A.rows > coarsest_unknowns) stalled = !add_level(coarsen(A));
+  while (!stalled && 3 * A.rows > coarsest_unknowns) stalled = !add_level(coarsen(A, prolongators));
   coarsest_unknowns_ = 3 * static_cast<Eigen::Index>(A.rows);
   if (coarsest_unknowns_ > std::max<Eigen::Index>(coarsest_unknowns, kLargestDenseCoarsest)) {
     // Coarsening stalled on a large level: most of its nodes have no strong neighbour (many

@@ -86,7 +86,8 @@ std::vector<int> aggregate_nodes(const std::vector<int>& start, const std::vecto
 /// aggregate's whose Frobenius norm is below `truncation` times the row's largest is dropped
 /// and lumped into the own aggregate's block, scaled so that P still maps each coarse
 /// translation (c_a = sqrt(|a|) t, which P_t maps to t on every node) to (I - omega B A) t:
-/// narrower rows, the same near null space. `truncation` 0 keeps every block. Deterministic.
+/// narrower rows, the same near null space. `truncation` 0 keeps every block; `omega` 0 gives
+/// P_t. Deterministic.
 BlockSparseMatrix smoothed_prolongator(const BlockSparseMatrix& A, const std::vector<int>& aggregate, int count,
                                        const std::vector<Eigen::Matrix3d>& block_inverse, double omega,
                                        double truncation);
@@ -106,11 +107,31 @@ class AdditiveMultilevel {
     UpperHalf,  ///< its upper half, diagonal included, and no block below the diagonal
   };
 
+  /// The default most unknowns of the coarsest level (factored densely).
+  static constexpr int kCoarsestUnknowns = 240;
+
+  /// The prolongators between levels.
+  enum class Prolongators {
+    /// Smoothed by one damped block-Jacobi step and truncated (smoothed_prolongator): wider
+    /// rows, fewer iterations on scalar grid operators, second order or bi-Laplacian (the
+    /// tests' grids: a Laplacian 36 against 148 iterations, a bi-Laplacian 478 against 919).
+    Smoothed,
+    /// The tentative ones, the translations of each aggregate (one block per row): a sparser
+    /// hierarchy, cheaper to build and apply. On the flow's coarse problems of curved surfaces,
+    /// whose blocks are stiff along normals that turn from node to node, they also took fewer
+    /// iterations (docs/benchmarks.md, "Tentative prolongators off planar regions"): the 10M
+    /// armadillo 72 -> 64 and its set-up 15.7 -> 11.6 s, amo 48 -> 37; on planar regions, where
+    /// the problem is a bi-Laplacian, more (a chamfered cube split to 141k vertices 114 -> 255).
+    Tentative,
+  };
+
   /// A: symmetric positive definite, stored as `storage` says (the upper half saves the lower
   /// half's copy, the set-up's largest matrix; the hierarchy is the same bytes either way).
   /// Coarsens until at most `coarsest_unknowns` unknowns remain or coarsening stalls. Throws
   /// std::runtime_error if the coarsest matrix is not numerically positive definite.
-  explicit AdditiveMultilevel(BlockSparseMatrix A, Storage storage = Storage::Whole, int coarsest_unknowns = 240);
+  explicit AdditiveMultilevel(BlockSparseMatrix A, Storage storage = Storage::Whole,
+                              int coarsest_unknowns = kCoarsestUnknowns,
+                              Prolongators prolongators = Prolongators::Smoothed);
 
   /// x = M b.
   void apply(const Eigen::VectorXd& b, Eigen::VectorXd& x) const;
