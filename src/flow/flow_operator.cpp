@@ -416,7 +416,7 @@ BlockSparseMatrix galerkin_upper(const FlowTerms& t, const AggregationCoarseSpac
             Eigen::Matrix3d& block = row[y.aggregate];
             block.noalias() += left * y.g;
             block.diagonal().array() += t.smooth[v] * x.l * y.l;
-            block.noalias() += (x.phi * y.phi) * D;
+            if (x.phi != 0 && y.phi != 0) block.noalias() += (x.phi * y.phi) * D;  // else a zero block: skipped
           }
         }
       },

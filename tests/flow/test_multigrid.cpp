@@ -219,35 +219,40 @@ TEST(Multigrid, TheUpperHalfGivesTheSameHierarchy) {
   // The flow hands its first coarse matrix over as its upper half (the set-up's largest matrix,
   // not copied whole). The hierarchy must be the same bytes: M u equal to the last bit, for a
   // matrix that coarsens over several levels, one already at the coarsest size, and one whose
-  // coarsening stalls at once.
-  auto expect_same = [](const BlockSparseMatrix& A, int coarsest_unknowns) {
-    const AdditiveMultilevel whole(A, AdditiveMultilevel::Storage::Whole, coarsest_unknowns);
-    const AdditiveMultilevel upper(upper_half(A), AdditiveMultilevel::Storage::UpperHalf, coarsest_unknowns);
-    EXPECT_EQ(whole.num_levels(), upper.num_levels());
-    EXPECT_EQ(whole.coarsest_unknowns(), upper.coarsest_unknowns());
-    std::mt19937 random(3);
-    std::normal_distribution<double> normal;
-    Eigen::VectorXd u(3 * A.rows), Mu_whole, Mu_upper;
-    for (Eigen::Index k = 0; k < u.size(); ++k) u[k] = normal(random);
-    whole.apply(u, Mu_whole);
-    upper.apply(u, Mu_upper);
-    EXPECT_TRUE(Mu_whole == Mu_upper) << "largest difference " << (Mu_whole - Mu_upper).cwiseAbs().maxCoeff();
-  };
-  const BlockSparseMatrix A = exactly_symmetric(congruent(bilaplacian(24, 1e-6), 5));
-  expect_same(A, 240);
-  expect_same(A, 3 * A.rows);  // no coarse level: factored whole
-  BlockSparseMatrix diagonal;  // no strong connection: coarsening stalls on the first level
-  diagonal.rows = diagonal.cols = 600;
-  for (int k = 0; k < diagonal.rows; ++k) {
-    diagonal.column.push_back(k);
-    diagonal.block.push_back((1.0 + 0.1 * (k % 5)) * Eigen::Matrix3d::Identity());
-    diagonal.start.push_back(k + 1);
-  }
-  expect_same(diagonal, 240);
-  {
-    const AdditiveMultilevel M(upper_half(diagonal), AdditiveMultilevel::Storage::UpperHalf, 240);
-    EXPECT_EQ(M.num_levels(), 1);
-    EXPECT_FALSE(M.coarsest_factored());
+  // coarsening stalls at once; with smoothed and with tentative prolongators (whose Galerkin
+  // product has its own code).
+  for (const auto prolongators :
+       {AdditiveMultilevel::Prolongators::Smoothed, AdditiveMultilevel::Prolongators::Tentative}) {
+    auto expect_same = [prolongators](const BlockSparseMatrix& A, int coarsest_unknowns) {
+      const AdditiveMultilevel whole(A, AdditiveMultilevel::Storage::Whole, coarsest_unknowns, prolongators);
+      const AdditiveMultilevel upper(upper_half(A), AdditiveMultilevel::Storage::UpperHalf, coarsest_unknowns,
+                                     prolongators);
+      EXPECT_EQ(whole.num_levels(), upper.num_levels());
+      EXPECT_EQ(whole.coarsest_unknowns(), upper.coarsest_unknowns());
+      std::mt19937 random(3);
+      std::normal_distribution<double> normal;
+      Eigen::VectorXd u(3 * A.rows), Mu_whole, Mu_upper;
+      for (Eigen::Index k = 0; k < u.size(); ++k) u[k] = normal(random);
+      whole.apply(u, Mu_whole);
+      upper.apply(u, Mu_upper);
+      EXPECT_TRUE(Mu_whole == Mu_upper) << "largest difference " << (Mu_whole - Mu_upper).cwiseAbs().maxCoeff();
+    };
+    const BlockSparseMatrix A = exactly_symmetric(congruent(bilaplacian(24, 1e-6), 5));
+    expect_same(A, 240);
+    expect_same(A, 3 * A.rows);  // no coarse level: factored whole
+    BlockSparseMatrix diagonal;  // no strong connection: coarsening stalls on the first level
+    diagonal.rows = diagonal.cols = 600;
+    for (int k = 0; k < diagonal.rows; ++k) {
+      diagonal.column.push_back(k);
+      diagonal.block.push_back((1.0 + 0.1 * (k % 5)) * Eigen::Matrix3d::Identity());
+      diagonal.start.push_back(k + 1);
+    }
+    expect_same(diagonal, 240);
+    {
+      const AdditiveMultilevel M(upper_half(diagonal), AdditiveMultilevel::Storage::UpperHalf, 240, prolongators);
+      EXPECT_EQ(M.num_levels(), 1);
+      EXPECT_FALSE(M.coarsest_factored());
+    }
   }
 }
 
