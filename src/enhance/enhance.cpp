@@ -643,15 +643,35 @@ EnhanceResult enhance_clean(const Mesh& mesh, const ReferenceSurface* reference,
 
 namespace enhance_detail {
 
-std::vector<Index> workable_faces(const Mesh& mesh) {
+std::vector<Index> workable_faces(const Mesh& mesh, std::optional<Topology>* topology) {
   const auto m = static_cast<std::size_t>(mesh.num_faces());
-  // Repeats of an earlier face (the reader's test, mesh/duplicate_faces.h), zero area, or a
-  // repeated vertex.
-  std::vector<char> out = find_duplicate_faces(mesh.F.data(), m, mesh.num_vertices());
-  for (const Index f : degenerate_faces(mesh.V, mesh.F)) out[static_cast<std::size_t>(f)] = 1;
+  // Zero area, a repeated vertex, or a repeat of an earlier face (the reader's test,
+  // mesh/duplicate_faces.h).
+  std::vector<char> out(m, 0);
+  bool held = false;
+  for (const Index f : degenerate_faces(mesh.V, mesh.F)) out[static_cast<std::size_t>(f)] = 1, held = true;
   for (Index f = 0; f < mesh.num_faces(); ++f)
     if (mesh.F(f, 0) == mesh.F(f, 1) || mesh.F(f, 1) == mesh.F(f, 2) || mesh.F(f, 2) == mesh.F(f, 0))
-      out[static_cast<std::size_t>(f)] = 1;
+      out[static_cast<std::size_t>(f)] = 1, held = true;
+  bool repeats_found = false;
+  if (topology && !held) {
+    // With no edge of more than two faces, a face with another's vertex set is adjacent to it
+    // across all three edges (0.7 s of sorting at 10M vertices saved; the topology is the run's).
+    *topology = build_topology(mesh.F, mesh.num_vertices());
+    const Topology& t = **topology;
+    if (t.non_manifold_edges.empty()) {
+      for (Index f = 0; f < mesh.num_faces(); ++f) {
+        const Index g = t.face_adjacency(f, 0);
+        if (g >= 0 && g < f && t.face_adjacency(f, 1) == g && t.face_adjacency(f, 2) == g)
+          out[static_cast<std::size_t>(f)] = 1;
+      }
+      repeats_found = true;
+    }
+  }
+  if (!repeats_found) {
+    const std::vector<char> repeats = find_duplicate_faces(mesh.F.data(), m, mesh.num_vertices());
+    for (std::size_t f = 0; f < m; ++f) out[f] |= repeats[f];
+  }
   std::vector<Index> faces;
   faces.reserve(m);
   for (std::size_t f = 0; f < m; ++f)
@@ -752,11 +772,15 @@ EnhanceResult enhance_keeping(const Mesh& mesh, const ReferenceSurface* referenc
     throw EnhanceOptionError(std::string("enhance: ") + e.what());
   }
   const Index n = mesh.num_vertices();
-  std::vector<Index> faces = enhance_detail::workable_faces(mesh);
+  std::optional<Topology> topology;  // of all faces, when workable_faces built it
+  std::vector<Index> faces = enhance_detail::workable_faces(mesh, &topology);
   const bool all_faces = faces.size() == static_cast<std::size_t>(mesh.num_faces());
   const Faces workable_F = all_faces ? Faces() : enhance_detail::face_rows(mesh.F, faces);
   const Faces& input_F = all_faces ? mesh.F : workable_F;
-  std::optional<Topology> topology = build_topology(input_F, n);
+  if (!all_faces || !topology) {
+    topology.reset();
+    topology = build_topology(input_F, n);
+  }
   // Seams stored cut open are welded for the methods and held as creases.
   const CutSeams cut = find_cut_seams(mesh.V, input_F, *topology);
   auto representative = [&](Index v) { return cut.empty() ? v : cut.representative[static_cast<std::size_t>(v)]; };

@@ -7,13 +7,18 @@
 #include "vertexflow/topology.h"
 
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 namespace vertexflow::enhance_detail {
 
 /// The faces with three distinct vertices, positive area (mesh.h's kDegenerateAreaRelative) that
 /// repeat no earlier face, in order. The others stay in the face list, their vertices held.
-std::vector<Index> workable_faces(const Mesh& mesh);
+/// When `topology` is given and every face has three distinct vertices and positive area, it
+/// receives build_topology(mesh.F, mesh.num_vertices()), which then proves the faces distinct
+/// where no edge has more than two faces (a face repeating another shares all three edges with
+/// it), without find_duplicate_faces' sort; otherwise it is left empty.
+std::vector<Index> workable_faces(const Mesh& mesh, std::optional<Topology>* topology = nullptr);
 
 /// `F`'s rows `faces`.
 Faces face_rows(const Faces& F, const std::vector<Index>& faces);
