@@ -14,7 +14,9 @@
 //   anisotropy (stiff along the normal, soft in the tangent plane) exactly.
 // - Multilevel: the same iteration with a coarse space added to the preconditioner
 //   (aggregation_coarse_space.h, multigrid.h): smoothed aggregates of one-rings whose Galerkin
-//   matrix is coarsened again. It is for the smooth tangential modes of large flat regions.
+//   matrix is coarsened again, with smoothed prolongators where a large region is planar and
+//   tentative ones elsewhere (kPlanarRegionForSmoothing). It is for the smooth tangential modes
+//   of large flat regions, and for long runs on large curved meshes.
 //
 // Why these two and how the choice is made (measured on this project's meshes, docs/benchmarks.md):
 // the coupled factorisation costs about n^1.5 (3.1e9 flops at 9k vertices, 1.8e10 at 43k, an
