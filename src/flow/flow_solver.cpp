@@ -183,8 +183,8 @@ std::unique_ptr<CoarseSpaceCorrection> make_multilevel(const FlowTerms& terms) {
   }
 }
 
-// The inverses of H's diagonal blocks (zero at fixed vertices): block-Jacobi, which captures
-// each vertex's anisotropy (stiff along the normal, soft in the tangent plane) exactly.
+}  // namespace
+
 std::vector<InverseFactor3f> block_jacobi(const FlowTerms& t) {
   std::vector<InverseFactor3f> inverse(static_cast<std::size_t>(t.n));
   parallel_for_index(t.n, [&](Index u) {
@@ -193,8 +193,6 @@ std::vector<InverseFactor3f> block_jacobi(const FlowTerms& t) {
   });
   return inverse;
 }
-
-}  // namespace
 
 AdditiveMultilevel::Prolongators multilevel_prolongators(const FlowTerms& terms) {
   const double planar = kPlanarCurvature / std::sqrt(static_cast<double>(std::max<Index>(terms.n, 1)));

@@ -48,6 +48,11 @@ class FlowSystemSolver {
   std::unique_ptr<Impl> impl_;
 };
 
+/// The inverses of H's diagonal blocks for `terms` (zero at fixed vertices): block-Jacobi, which
+/// captures each vertex's anisotropy (stiff along the normal, soft in the tangent plane)
+/// exactly; the preconditioner of every iterative path.
+std::vector<InverseFactor3f> block_jacobi(const FlowTerms& terms);
+
 /// The prolongators of the multilevel path's hierarchy (multigrid.h) for the system of `terms`:
 /// Smoothed where a connected region of at least 600 free vertices is planar at the mesh's own
 /// scale (|k1| + |k2| below 0.1 / sqrt(n) per mean edge length, n vertices), else Tentative

@@ -209,14 +209,20 @@ double spectral_radius(const std::vector<Matrix3>& inverse_diagonal, const Rows&
   return lambda;
 }
 
+// The tentative prolongator's unit-length columns: phi_a = I / sqrt(|a|) on each node of
+// aggregate a; returns 1 / sqrt(|a|) per aggregate.
+std::vector<double> aggregate_scales(const std::vector<int>& aggregate, int count) {
+  std::vector<double> scale(static_cast<std::size_t>(count), 0.0);
+  for (const int a : aggregate) scale[static_cast<std::size_t>(a)] += 1;
+  for (double& s : scale) s = 1.0 / std::sqrt(s);
+  return scale;
+}
+
 template <class Rows>
 BlockSparseMatrix smoothed_prolongator_of(const Rows& A, const std::vector<int>& aggregate, int count,
                                           const std::vector<Eigen::Matrix3d>& block_inverse, double omega,
                                           double truncation) {
-  // Unit-length columns: phi_a = I / sqrt(|a|) on each node of aggregate a.
-  std::vector<double> scale(static_cast<std::size_t>(count), 0.0);
-  for (const int a : aggregate) scale[static_cast<std::size_t>(a)] += 1;
-  for (double& s : scale) s = 1.0 / std::sqrt(s);
+  const std::vector<double> scale = aggregate_scales(aggregate, count);
   tbb::enumerable_thread_specific<std::vector<std::pair<int, Matrix3>>> scratch;
   return build_block_rows(A.rows, count, [&](int k, BlockRowAccumulator& row) {
     // The row's blocks by aggregate, summed in A's column order (a handful: linear search).
@@ -529,9 +535,7 @@ BlockSparseMatrix galerkin_product(const Rows& A, const BasicBlockSparseMatrix<S
 // The tentative prolongator in float: row k one block s I in column aggregate[k], s = 1 /
 // sqrt(|a|) (smoothed_prolongator's P_t, the blocks it would give with omega 0, rounded).
 FloatBlockSparseMatrix tentative_prolongator(const std::vector<int>& aggregate, int count) {
-  std::vector<double> scale(static_cast<std::size_t>(count), 0.0);
-  for (const int a : aggregate) scale[static_cast<std::size_t>(a)] += 1;
-  for (double& s : scale) s = 1.0 / std::sqrt(s);
+  const std::vector<double> scale = aggregate_scales(aggregate, count);
   FloatBlockSparseMatrix P;
   P.rows = static_cast<int>(aggregate.size());
   P.cols = count;

@@ -174,11 +174,7 @@ int multilevel_iterations(const Problem& p, const FlowTerms& terms, AdditiveMult
   const BlockVector b = op.right_hand_side(to_local(terms, p.frame.P.data()));
   auto space = std::make_shared<const AggregationCoarseSpace>(terms.ring_start, terms.ring, terms.fixed);
   CoarseSpaceCorrection correction(space, galerkin_upper(terms, *space), kind);
-  std::vector<InverseFactor3f> inverse(static_cast<std::size_t>(terms.n));
-  for (Index u = 0; u < terms.n; ++u)
-    if (!terms.fixed[static_cast<std::size_t>(u)])
-      inverse[static_cast<std::size_t>(u)] = InverseFactor3f::of_inverse(diagonal_block(terms, u));
-  ConjugateGradients cg(op, std::move(inverse), b, &correction);
+  ConjugateGradients cg(op, block_jacobi(terms), b, &correction);
   const IterationResult result = cg.run(2000, FlowOptions{}.solver_tolerance);
   EXPECT_TRUE(result.converged);
   return result.iterations;
