@@ -83,13 +83,12 @@ constexpr Index kFlatRegionForMultilevel = 500;
 // approximate badly; on curved surfaces the tentative ones took as few or fewer iterations and
 // a third less set-up. Measured (largest planar region; `--solver multilevel` iterations
 // smoothed against tentative, docs/benchmarks.md): fandisk split to 932k vertices 214,316, 155
-// / 344; chamfer-cube split to 141k 5,929, 114 / 255; fandisk 1,257, 54 / 68; against amo 297,
-// 48 / 37; the 10M armadillo (each edge split in three) under 490, 72 / 64 (set-up 15.7 / 11.6
-// s); rocker-arm split to 362k under 40, 56 / 40. The test of kFlatCurvaturePerEdge, relative
-// to the edge length, does not separate them: a finer mesh looks flatter, and the 10M
-// armadillo's largest region under it has 1,556 vertices.
+// / 344 (measured in an earlier session); chamfer-cube split to 141k 5,929, 114 / 255; fandisk 1,257, 54 / 68; against
+// amo 301, 48 / 37; the 10M armadillo (each edge split in three) 144, 72 / 64 (set-up 15.7 / 11.6 s); rocker-arm split
+// to 362k 18, 56 / 40. The test of kFlatCurvaturePerEdge, relative to the edge length, does not separate them: a finer
+// mesh looks flatter, and the 10M armadillo's largest region under it has 1,556 vertices.
 constexpr double kPlanarCurvature = 0.1;
-constexpr Index kPlanarRegionForSmoothing = 600;  // between 297 and 1,257, a factor of two from each
+constexpr Index kPlanarRegionForSmoothing = 600;  // between 301 and 1,257, a factor of two from each
 // The iterations' products keep the operator's per-vertex caches in float (flow_operator.h: 48
 // bytes per vertex less at the solve's peak) where they stop at a relative residual of at least
 // this, 20 times those products' rounding (about 5e-8); tighter tolerances get exact products,
