@@ -4,6 +4,7 @@
 #include "flow_setup.h"
 
 #include "common/bucket_by_key.h"
+#include "common/concurrent_union_find.h"
 #include "numerics/parallel.h"
 
 #include "vertexflow/curvature.h"
@@ -83,28 +84,17 @@ SurfaceFeatures detect_features_without_normals(const Vertices& V, const Faces& 
         features.sharp_edge[e] = 0;
     }
   }
-  // Patches: flood fill across non-sharp interior edges.
-  features.face_patch.assign(static_cast<std::size_t>(F.rows()), -1);
-  Index patches = 0;
-  std::vector<Index> stack;
-  for (Index seed = 0; seed < F.rows(); ++seed) {
-    if (features.face_patch[static_cast<std::size_t>(seed)] >= 0) continue;
-    features.face_patch[static_cast<std::size_t>(seed)] = patches;
-    stack.push_back(seed);
-    while (!stack.empty()) {
-      const Index f = stack.back();
-      stack.pop_back();
-      for (int k = 0; k < 3; ++k) {
-        const Index g = topology.face_adjacency(f, k);
-        if (g < 0 || features.sharp_edge[static_cast<std::size_t>(topology.face_edges(f, k))] ||
-            features.face_patch[static_cast<std::size_t>(g)] >= 0)
-          continue;
-        features.face_patch[static_cast<std::size_t>(g)] = patches;
-        stack.push_back(g);
-      }
+  // Patches: the face sets connected across non-sharp interior edges, numbered in the order of
+  // their first faces (as a flood fill from each unvisited face in order numbers them), on all
+  // threads (concurrent_union_find.h; the flood fill took 0.43 s at 10M vertices).
+  ConcurrentUnionFind patches(features.face_patch, static_cast<Index>(F.rows()));
+  parallel_for_index(static_cast<Index>(F.rows()), [&](Index f) {
+    for (int k = 0; k < 3; ++k) {
+      const Index g = topology.face_adjacency(f, k);
+      if (g > f && !features.sharp_edge[static_cast<std::size_t>(topology.face_edges(f, k))]) patches.unite(f, g);
     }
-    ++patches;
-  }
+  });
+  patches.number_sets();
   // A crease separates two patches: the features of a CAD part form a network that cuts the
   // surface into faces. A sharp edge with the same patch on both sides belongs to a chain that
   // ends inside one patch: on a scan, an under-sampled ridge or noise (bunny_uniform: 268 sharp

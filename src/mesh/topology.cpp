@@ -1,6 +1,8 @@
 #include "vertexflow/topology.h"
 
 #include "common/bucket_by_key.h"
+#include "common/concurrent_union_find.h"
+#include "numerics/parallel.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -51,22 +53,6 @@ std::vector<Index> offsets_from_counts(const std::vector<Index>& counts) {
   std::inclusive_scan(counts.begin(), counts.end(), offsets.begin() + 1);
   return offsets;
 }
-
-struct UnionFind {
-  std::vector<Index> parent;
-  explicit UnionFind(Index n) : parent(static_cast<std::size_t>(n)) { std::iota(parent.begin(), parent.end(), 0); }
-  Index find(Index x) {
-    while (parent[static_cast<std::size_t>(x)] != x) {
-      parent[static_cast<std::size_t>(x)] = parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
-      x = parent[static_cast<std::size_t>(x)];
-    }
-    return x;
-  }
-  void unite(Index a, Index b) {
-    a = find(a), b = find(b);
-    if (a != b) parent[static_cast<std::size_t>(std::max(a, b))] = std::min(a, b);
-  }
-};
 
 // Fans of at most this many faces find a link vertex's wedges by scanning the fan's 2 count
 // ends; larger ones (a cone apex can have thousands of faces) sort the ends once and search
@@ -419,20 +405,16 @@ Topology build_topology(const Faces& F, Index num_vertices) {
     }
   }
 
-  // Connected components (vertices joined by faces), numbered in order of first vertex.
+  // Connected components (vertices joined by faces), numbered in order of first vertex, on all
+  // threads (concurrent_union_find.h).
   {
-    UnionFind sets(nv);
-    for (Index f = 0; f < nf; ++f) sets.unite(F(f, 0), F(f, 1)), sets.unite(F(f, 1), F(f, 2));
-    t.vertex_component.assign(static_cast<std::size_t>(nv), -1);
-    std::vector<Index> label(static_cast<std::size_t>(nv), -1);
-    for (Index v = 0; v < nv; ++v) {
-      Index& l = label[static_cast<std::size_t>(sets.find(v))];
-      if (l < 0) l = t.num_components++;
-      t.vertex_component[static_cast<std::size_t>(v)] = l;
-    }
+    ConcurrentUnionFind sets(t.vertex_component, nv);
+    parallel_for_index(nf, [&](Index f) { sets.unite(F(f, 0), F(f, 1)), sets.unite(F(f, 1), F(f, 2)); });
+    t.num_components = sets.number_sets();
     t.face_component.resize(static_cast<std::size_t>(nf));
-    for (Index f = 0; f < nf; ++f)
+    parallel_for_index(nf, [&](Index f) {
       t.face_component[static_cast<std::size_t>(f)] = t.vertex_component[static_cast<std::size_t>(F(f, 0))];
+    });
   }
   return t;
 }

@@ -8,9 +8,11 @@
 #include "vertexflow/topology.h"
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <cmath>
+#include <vector>
 
 namespace vertexflow {
 namespace {
@@ -103,6 +105,46 @@ TEST(FeatureDetection, ScannedBunnyHasFewCornersAndCadPartsKeepTheirs) {
   // The chamfered cube: every vertex is a corner of its 45-degree chamfers.
   const SurfaceFeatures cube = features_of(read_mesh(test::data_path("chamfer-cube.off")));
   EXPECT_EQ(count(cube, SurfaceFeatures::Kind::Corner), 24);
+}
+
+TEST(FeatureDetection, PatchesAreTheFloodFillsAcrossNonSharpEdgesInFaceOrder) {
+  // The patches are found on all threads (concurrent_union_find.h); they must be the sets a flood
+  // fill from each unlabelled face in order finds across the interior edges left non-sharp,
+  // numbered in that order (an edge unmarked for ending inside one patch joins nothing new).
+  // At 40 degrees fandisk has 12 patches, the chamfered cube 7 and the open perforated plate 21
+  // (measured); the plate's faces also come shuffled, and each case runs on one thread and on
+  // two.
+  const Mesh plate = test::perforated_plate(2, 3, 0.3, false);
+  for (const Mesh& mesh : {read_mesh(test::data_path("fandisk.off")), read_mesh(test::data_path("chamfer-cube.off")),
+                           plate, test::renumbered(plate, 5, true).mesh}) {
+    const Topology topology = build_topology(mesh.F, mesh.num_vertices());
+    for (const int threads : {1, 2}) {
+      tbb::global_control limit(tbb::global_control::max_allowed_parallelism, threads);
+      const SurfaceFeatures features = detect_features(mesh.V, mesh.F, topology, 40.0);
+      std::vector<Index> expected(static_cast<std::size_t>(mesh.num_faces()), -1);
+      Index patches = 0;
+      for (Index seed = 0; seed < mesh.num_faces(); ++seed) {
+        if (expected[static_cast<std::size_t>(seed)] >= 0) continue;
+        std::vector<Index> stack{seed};
+        expected[static_cast<std::size_t>(seed)] = patches;
+        while (!stack.empty()) {
+          const Index f = stack.back();
+          stack.pop_back();
+          for (int k = 0; k < 3; ++k) {
+            const Index g = topology.face_adjacency(f, k);
+            if (g >= 0 && !features.sharp_edge[static_cast<std::size_t>(topology.face_edges(f, k))] &&
+                expected[static_cast<std::size_t>(g)] < 0) {
+              expected[static_cast<std::size_t>(g)] = patches;
+              stack.push_back(g);
+            }
+          }
+        }
+        ++patches;
+      }
+      EXPECT_GE(patches, 7);  // the creases cut each of these into 7-21 patches
+      EXPECT_EQ(features.face_patch, expected) << mesh.num_faces() << " faces, " << threads << " threads";
+    }
+  }
 }
 
 }  // namespace
