@@ -13,7 +13,8 @@ FlowTerms make_flow_terms(const Topology& topology, const std::vector<char>& fix
   t.n = static_cast<Index>(frame.P.rows());
   const auto n = static_cast<std::size_t>(t.n);
   t.original = std::move(order);
-  // Mesh vertex -> local index, for the rings only: not kept through the solve (4 bytes a vertex).
+  // Mesh vertex -> local index, for the rings and the terms: not kept through the solve (4 bytes a
+  // vertex).
   std::vector<Index> local(n);
   for (std::size_t k = 0; k < n; ++k) local[static_cast<std::size_t>(t.original[k])] = static_cast<Index>(k);
   t.ring_start.resize(n + 1);
@@ -40,9 +41,11 @@ FlowTerms make_flow_terms(const Topology& topology, const std::vector<char>& fix
   const double w_em = topology.num_edges() > 0 ? 1.0 / topology.num_edges() : 0.0;
   const double w_sd = weights.lambda / nv, w_pull = weights.epsilon * weights.lambda / nv,
                w_sliver = weights.sliver / nv;
-  parallel_for_index(t.n, [&](Index k) {
-    const auto v = static_cast<std::size_t>(k);
-    const Index i = t.original[v];
+  // In the mesh's order, writing each vertex's terms at its local index: the curvature and the
+  // positions are read in order, the rows of the terms written out of order (reading them out of
+  // order, as the loop over local indices did, took a fifth more at 1M vertices).
+  parallel_for_index(t.n, [&](Index i) {
+    const auto v = static_cast<std::size_t>(local[static_cast<std::size_t>(i)]);
     const Eigen::Vector3d t1 = c.T1.row(i).transpose(), t2 = c.T2.row(i).transpose(), normal = c.N.row(i).transpose();
     t.K.set(v,
             Sym3f(Eigen::Matrix3d(std::abs(c.k1[i]) * t1 * t1.transpose() + std::abs(c.k2[i]) * t2 * t2.transpose())));
