@@ -285,6 +285,10 @@ FlowSystemSolver::FlowSystemSolver(const Topology& topology, std::vector<char> f
 
 FlowSystemSolver::~FlowSystemSolver() = default;
 
+const std::vector<Index>& FlowSystemSolver::vertex_order() const {
+  return impl_->order;
+}
+
 void FlowSystemSolver::set_progress_phase(std::string phase) {
   impl_->progress_phase = std::move(phase);
 }

@@ -42,6 +42,10 @@ class FlowSystemSolver {
   /// caller places the solve's part (ProgressPart); the default is "solve".
   void set_progress_phase(std::string phase);
 
+  /// The vertices in the order the solve numbers them (breadth first from a space-filling order:
+  /// neighbours close together), or empty before the first solve.
+  [[nodiscard]] const std::vector<Index>& vertex_order() const;
+
  private:
   Vertices solve(const FlowFrame& frame, FlowFrame* release, const EnergyWeights& weights, FlowReport& report);
   struct Impl;
