@@ -1,6 +1,8 @@
 // Faces that repeat an earlier face (mesh/duplicate_faces.h).
 #include "mesh/duplicate_faces.h"
 
+#include "common/bucket_by_key.h"
+
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -10,20 +12,25 @@
 namespace vertexflow {
 
 std::vector<char> find_duplicate_faces(const Index* tris, std::size_t nf, Index num_vertices) {
+  // Each face's sorted corners, and the faces bucketed by their smallest corner in face order: a
+  // counting sort in two fixed chunks of faces, counted and placed on both threads, which gives
+  // the buckets of one serial pass (that pass was most of the 0.06 s this took at 2M faces).
   std::vector<std::array<Index, 3>> keys(nf);
-  std::vector<Index> start(static_cast<std::size_t>(num_vertices) + 1, 0);
-  for (std::size_t f = 0; f < nf; ++f) {
-    std::array<Index, 3> k{tris[3 * f], tris[3 * f + 1], tris[3 * f + 2]};
-    std::sort(k.begin(), k.end());
-    keys[f] = k;
-    ++start[static_cast<std::size_t>(k[0]) + 1];
-  }
-  for (std::size_t v = 0; v < static_cast<std::size_t>(num_vertices); ++v) start[v + 1] += start[v];
-  std::vector<Index> order(nf);
-  {
-    std::vector<Index> fill(start.begin(), start.end() - 1);
-    for (std::size_t f = 0; f < nf; ++f) order[static_cast<std::size_t>(fill[keys[f][0]]++)] = static_cast<Index>(f);
-  }
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 16384), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t f = range.begin(); f != range.end(); ++f) {
+      std::array<Index, 3> k{tris[3 * f], tris[3 * f + 1], tris[3 * f + 2]};
+      std::sort(k.begin(), k.end());
+      keys[f] = k;
+    }
+  });
+  constexpr std::size_t kChunks = 2;
+  KeyBuckets<Index, Index> buckets = bucket_by_key_in_chunks<Index, Index>(
+      static_cast<std::size_t>(num_vertices), kChunks, [&](std::size_t chunk, auto&& emit) {
+        const auto [first, last] = chunk_range(nf, kChunks, chunk);
+        for (std::size_t f = first; f < last; ++f) emit(static_cast<std::size_t>(keys[f][0]), static_cast<Index>(f));
+      });
+  const std::vector<Index>& start = buckets.start;
+  std::vector<Index>& order = buckets.items;
   std::vector<char> duplicate(nf, 0);
   // Buckets are independent and each writes only its own faces' flags: parallel and
   // deterministic.
