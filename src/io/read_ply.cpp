@@ -445,11 +445,14 @@ class PlyParser {
   // same size), when they are all in memory: the bytes of the first, else null (then the
   // records are read one by one).
   const char* fixed_records(const Element& element, std::uint64_t n) {
-    if (encoding_ == Encoding::Ascii || !source_.complete() || n == 0) return nullptr;
     for (const Property& p : element.properties)
       if (p.is_list) return nullptr;
-    const std::uint64_t bytes = n * record_size(element);
-    if (body_ + bytes > source_.end()) return nullptr;  // the one-by-one read reports where it ends
+    return n == 0 ? nullptr : records_in_memory(n * record_size(element));
+  }
+  // The next `bytes` bytes of a binary body when the whole content is in memory (a plain file)
+  // and holds them, else null: then the one-by-one read reports where the content ends.
+  const char* records_in_memory(std::uint64_t bytes) const {
+    if (encoding_ == Encoding::Ascii || !source_.complete() || body_ + bytes > source_.end()) return nullptr;
     return source_.data().data() + (body_ - source_.offset());
   }
   static std::size_t record_size(const Element& element) {
@@ -491,14 +494,13 @@ class PlyParser {
   // are then read one by one. An invalid index fails with the message of the one-by-one read,
   // for the first face that has one.
   bool decode_triangles(const Element& element) {
-    if (encoding_ == Encoding::Ascii || !source_.complete() || element.count == 0 || element.properties.size() != 1)
-      return false;
+    if (element.count == 0 || element.properties.size() != 1) return false;
     const Property& p = element.properties[0];
     if (type_size(p.count_type) != 1 || (p.type != Type::Int32 && p.type != Type::UInt32)) return false;
     constexpr std::size_t kRecord = 13;
     const auto n = static_cast<std::size_t>(element.count);
-    if (body_ + n * kRecord > source_.end()) return false;
-    const char* records = source_.data().data() + (body_ - source_.offset());
+    const char* records = records_in_memory(n * kRecord);
+    if (records == nullptr) return false;
     const bool all_triangles = tbb::parallel_reduce(
         tbb::blocked_range<std::size_t>(0, n, 65536), true,
         [&](const tbb::blocked_range<std::size_t>& range, bool ok) {
@@ -510,12 +512,16 @@ class PlyParser {
     const std::size_t first_corner = soup_.corners.size(), first_polygon = soup_.offsets.size();
     soup_.corners.resize(first_corner + 3 * n);
     soup_.offsets.resize(first_polygon + n);
+    auto index_at = [&](std::size_t f, std::size_t k) {
+      return load_as<std::int64_t>(records + f * kRecord + 1 + 4 * k, p.type, swap_);
+    };
+    auto valid = [](std::int64_t index) { return index >= 0 && index <= std::numeric_limits<Index>::max(); };
     std::atomic<std::size_t> first_invalid{n};
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16384), [&](const tbb::blocked_range<std::size_t>& range) {
       for (std::size_t f = range.begin(); f != range.end(); ++f) {
         for (std::size_t k = 0; k < 3; ++k) {
-          const std::int64_t index = load_as<std::int64_t>(records + f * kRecord + 1 + 4 * k, p.type, swap_);
-          if (index < 0 || index > std::numeric_limits<Index>::max()) {
+          const std::int64_t index = index_at(f, k);
+          if (!valid(index)) {
             std::size_t seen = first_invalid.load(std::memory_order_relaxed);
             while (f < seen && !first_invalid.compare_exchange_weak(seen, f, std::memory_order_relaxed)) {
             }
@@ -526,11 +532,9 @@ class PlyParser {
       }
     });
     if (const std::size_t f = first_invalid.load(); f < n)
-      for (std::size_t k = 0; k < 3; ++k) {
-        const std::int64_t index = load_as<std::int64_t>(records + f * kRecord + 1 + 4 * k, p.type, swap_);
-        if (index < 0 || index > std::numeric_limits<Index>::max())
-          fail(name_, fmt::format("{} {} has invalid vertex index {}", element.name, f, index));
-      }
+      for (std::size_t k = 0; k < 3; ++k)
+        if (!valid(index_at(f, k)))
+          fail(name_, fmt::format("{} {} has invalid vertex index {}", element.name, f, index_at(f, k)));
     body_ += n * kRecord;
     return true;
   }
